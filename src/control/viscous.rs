@@ -1,0 +1,37 @@
+//! Linear viscous damping, eq. 1: `F_d = -B · v`. It damps motion in every direction alike,
+//! the useful part along the guidance included — the reason it must trade speed for safety.
+
+use nalgebra::SVector;
+
+use super::Damping;
+
+/// Viscous damping.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Viscous {
+    /// Damping coefficient B, N·s/m (kg/s). For a 1 kg body with K = 1 N guidance, B below about
+    /// 0.2 lets it hit walls and B above 1 makes it crawl (paper figures 4–8, 23).
+    pub b: f64,
+}
+
+impl<const N: usize> Damping<N> for Viscous {
+    fn force(&self, v: &SVector<f64, N>, _g: &SVector<f64, N>) -> SVector<f64, N> {
+        -v * self.b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector2;
+
+    #[test]
+    fn viscous_damping_opposes_velocity_whatever_the_guidance() {
+        let d = Viscous { b: 0.7 };
+        let v = Vector2::new(1.0, -2.0);
+        assert_eq!(
+            d.force(&v, &Vector2::new(1.0, 0.0)),
+            Vector2::new(-0.7, 1.4)
+        );
+        assert_eq!(d.force(&v, &Vector2::zeros()), Vector2::new(-0.7, 1.4));
+    }
+}

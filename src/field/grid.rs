@@ -1,0 +1,97 @@
+//! The regular grid the field lives on: cell `(i, j)` has its centre at
+//! `((i + ½)·h, (j + ½)·h)`, so the grid covers the box `[0, W] × [0, H]` from its corner.
+
+/// A regular grid over the world's box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grid {
+    /// Cells along x.
+    pub nx: usize,
+    /// Cells along y.
+    pub ny: usize,
+    /// Cell size h, m.
+    pub cell: f64,
+}
+
+impl Grid {
+    /// The grid of `cell`-sized cells that covers a box of `size` metres.
+    pub fn covering(size: [f64; 2], cell: f64) -> Self {
+        Self {
+            nx: ((size[0] / cell).ceil() as usize).max(1),
+            ny: ((size[1] / cell).ceil() as usize).max(1),
+            cell,
+        }
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Whether the grid has no cells (never, for a grid built by [`Grid::covering`]).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Linear index of cell `(i, j)`, x index fastest.
+    pub fn index(&self, i: usize, j: usize) -> usize {
+        j * self.nx + i
+    }
+
+    /// Centre of cell `(i, j)`, m.
+    pub fn center(&self, i: usize, j: usize) -> [f64; 2] {
+        [(i as f64 + 0.5) * self.cell, (j as f64 + 0.5) * self.cell]
+    }
+
+    /// The cell containing point `p`, if it is on the grid.
+    pub fn cell_of(&self, p: [f64; 2]) -> Option<(usize, usize)> {
+        let (fx, fy) = (p[0] / self.cell, p[1] / self.cell);
+        if !(fx >= 0.0 && fy >= 0.0) {
+            return None;
+        }
+        let (i, j) = (fx as usize, fy as usize);
+        (i < self.nx && j < self.ny).then_some((i, j))
+    }
+
+    /// The cells within the axis-aligned rectangle `[lo, hi]`, clamped to the grid, as index
+    /// ranges `(i_range, j_range)`.
+    pub fn cells_in(
+        &self,
+        lo: [f64; 2],
+        hi: [f64; 2],
+    ) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+        let range = |lo: f64, hi: f64, n: usize| {
+            let a = (lo / self.cell - 0.5).floor().max(0.0) as usize;
+            let b = ((hi / self.cell - 0.5).ceil() + 1.0).clamp(0.0, n as f64) as usize;
+            a.min(n)..b
+        };
+        (range(lo[0], hi[0], self.nx), range(lo[1], hi[1], self.ny))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn covering_rounds_up_and_centres_are_half_a_cell_in() {
+        let g = Grid::covering([1.0, 0.52], 0.1);
+        assert_eq!((g.nx, g.ny), (10, 6));
+        assert_eq!(g.center(0, 0), [0.05, 0.05]);
+        assert_eq!(g.cell_of([0.95, 0.51]), Some((9, 5)));
+        assert_eq!(g.cell_of([-0.01, 0.2]), None);
+        assert_eq!(g.cell_of([1.05, 0.2]), None);
+    }
+
+    #[test]
+    fn cells_in_covers_every_centre_inside_the_rectangle() {
+        let g = Grid::covering([1.0, 1.0], 0.1);
+        let (ir, jr) = g.cells_in([0.22, 0.0], [0.48, 1.0]);
+        for i in 0..g.nx {
+            let c = g.center(i, 0)[0];
+            if (0.22..=0.48).contains(&c) {
+                assert!(ir.contains(&i), "{i} {ir:?}");
+            }
+        }
+        assert_eq!(jr, 0..10);
+    }
+}

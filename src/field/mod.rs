@@ -1,0 +1,146 @@
+//! The harmonic guidance field of one agent (paper §II, eq. 3–4).
+//!
+//! The walls are rasterized into a configuration-space mask for the agent's radius
+//! ([`mask`]), Laplace's equation is solved on the free cells ([`laplace`]), and the result is
+//! sampled smoothly anywhere in the box ([`sample`]); the kinematic path is the streamline of
+//! the normalized guidance from the start ([`streamline`]).
+
+pub mod grid;
+pub mod laplace;
+pub mod mask;
+pub mod sample;
+pub mod streamline;
+
+use std::time::{Duration, Instant};
+
+use nalgebra::Vector2;
+
+pub use grid::Grid;
+pub use sample::Sampler;
+pub use streamline::Streamline;
+
+use crate::world::{Agent, World, all_wall_shapes};
+
+/// Most SOR sweeps before the solver gives up.
+pub const MAX_SWEEPS: usize = 200_000;
+
+/// Why a field could not be built for an agent.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FieldError {
+    /// The target lies in a blocked cell.
+    #[error(
+        "agent `{agent}`: its target is within its radius of a wall on the {cell} m grid; move the target away from the wall or use a smaller field.cell"
+    )]
+    TargetBlocked {
+        /// The agent's name.
+        agent: String,
+        /// The grid cell size, m.
+        cell: f64,
+    },
+    /// No free path connects the start to the target.
+    #[error(
+        "agent `{agent}`: its target cannot be reached from its start (no free path for a disc of radius {radius} m); the task is intractable"
+    )]
+    Unreachable {
+        /// The agent's name.
+        agent: String,
+        /// The agent's radius, m.
+        radius: f64,
+    },
+    /// The solver did not converge.
+    #[error("agent `{agent}`: the Laplace solver failed: {source}")]
+    Solver {
+        /// The agent's name.
+        agent: String,
+        /// What the solver reported.
+        source: laplace::SolveError,
+    },
+}
+
+/// The solved field of one agent, with the statistics of the solve.
+#[derive(Debug, Clone)]
+pub struct HarmonicField {
+    /// The field, ready to sample.
+    pub sampler: Sampler,
+    /// The configuration-space mask: `true` where the agent's centre cannot be.
+    pub blocked: Vec<bool>,
+    /// The target, m.
+    pub target: [f64; 2],
+    /// SOR sweeps the solve took.
+    pub iterations: usize,
+    /// The largest relative per-cell change in the last sweep.
+    pub relative_change: f64,
+    /// Wall-clock time of the solve.
+    pub solve_time: Duration,
+}
+
+impl HarmonicField {
+    /// Rasterizes the world for `agent` and solves its field.
+    pub fn solve(world: &World, agent: &Agent) -> Result<Self, FieldError> {
+        let started = Instant::now();
+        let grid = Grid::covering(world.size, world.field.cell);
+        let walls = all_wall_shapes(world);
+        let blocked = mask::rasterize(&grid, world.size, &walls, agent.radius);
+        let target_cell = grid
+            .cell_of(agent.target)
+            .filter(|&(i, j)| !blocked[grid.index(i, j)])
+            .ok_or_else(|| FieldError::TargetBlocked {
+                agent: agent.name.clone(),
+                cell: grid.cell,
+            })?;
+        let solution = laplace::solve_sor(
+            &grid,
+            &blocked,
+            target_cell,
+            world.field.tolerance,
+            MAX_SWEEPS,
+        )
+        .map_err(|source| FieldError::Solver {
+            agent: agent.name.clone(),
+            source,
+        })?;
+        let field = Self {
+            sampler: Sampler::new(grid, solution.w, solution.reachable),
+            blocked,
+            target: agent.target,
+            iterations: solution.iterations,
+            relative_change: solution.relative_change,
+            solve_time: started.elapsed(),
+        };
+        if field.sampler.grad_w(agent.start).is_none() {
+            return Err(FieldError::Unreachable {
+                agent: agent.name.clone(),
+                radius: agent.radius,
+            });
+        }
+        Ok(field)
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        self.sampler.grid()
+    }
+
+    /// The potential `V` at `p` (1 where nothing reachable is near).
+    pub fn potential(&self, p: [f64; 2]) -> f64 {
+        1.0 - self.sampler.w(p).unwrap_or(0.0)
+    }
+
+    /// `1 - V` at `p`, with full relative precision where `V` is close to 1.
+    pub fn one_minus_potential(&self, p: [f64; 2]) -> f64 {
+        self.sampler.w(p).unwrap_or(0.0)
+    }
+
+    /// The gradient `g = ∇V` at `p`; `None` where the field is undefined (far from any
+    /// reachable cell). Callers treat `None` like a vanishing gradient.
+    pub fn gradient(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
+        self.sampler.grad_w(p).map(|g| -g)
+    }
+
+    /// The kinematic path from `start` (eq. 4, normalized).
+    pub fn streamline(&self, start: [f64; 2]) -> Streamline {
+        let g = self.grid();
+        let max_length = 4.0 * (g.nx * g.ny) as f64 * g.cell;
+        streamline::streamline(&self.sampler, start, self.target, max_length)
+    }
+}

@@ -1,0 +1,23 @@
+//! # nadf — a physics sandbox for kinodynamic motion planning
+//!
+//! nadf steers bodies with mass through cluttered worlds with a harmonic potential field and
+//! the nonlinear anisotropic damping force (NADF) of Masoud's paper "Kinodynamic Motion
+//! Planning: A Novel Type of Nonlinear, Passive Damping Forces", on Rapier rigid bodies, and
+//! records every run for the Rerun viewer.
+//!
+//! - [`world`]: the world file (TOML): schema, loading with `--set` overrides, validation.
+//! - [`field`]: the configuration-space mask, the Laplace solver, gradient sampling and the
+//!   kinematic streamline.
+//! - [`control`]: guidance and the damping laws (viscous, NADF) behind one trait.
+//! - [`sim`]: the Rapier world and the step loop.
+//! - [`metrics`]: what a run reports per agent.
+//! - [`record`]: the Rerun recording.
+//! - [`run`](mod@run): a whole headless run, as the `nadf run` command does it.
+
+pub mod control;
+pub mod field;
+pub mod metrics;
+pub mod record;
+pub mod run;
+pub mod sim;
+pub mod world;

@@ -1,0 +1,146 @@
+//! The `nadf` command line: parses arguments and calls the library.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use nadf::run::{RunError, RunOptions, run};
+use nadf::world::{Override, load};
+
+/// Exit status for bad input (a world file, an override or an intractable task).
+const BAD_INPUT: u8 = 2;
+/// Exit status for a run that could not complete (e.g. an output could not be written).
+const FAILED: u8 = 1;
+
+#[derive(Parser)]
+#[command(
+    name = "nadf",
+    version,
+    about = "Kinodynamic motion planning sandbox: harmonic potential fields and NADF on Rapier bodies, recorded for Rerun"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a world headlessly to its duration, write a Rerun recording and print a summary.
+    Run {
+        /// The world file (TOML).
+        world: PathBuf,
+        /// The recording to write [default: WORLD_STEM.rrd in the current directory].
+        #[arg(short, long, value_name = "OUT.rrd")]
+        output: Option<PathBuf>,
+        /// Do not write a recording.
+        #[arg(long, conflicts_with = "output")]
+        no_record: bool,
+        /// Also write the summary as JSON to this file.
+        #[arg(long, value_name = "SUMMARY.json")]
+        json: Option<PathBuf>,
+        /// Override a world value by dotted path, array items by index
+        /// (e.g. --set agents.0.controller.b=0.7). Repeatable.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<Override>,
+    },
+    /// Validate world files and print every problem found (file, line, key).
+    Check {
+        /// The world files.
+        #[arg(required = true)]
+        worlds: Vec<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    match Cli::parse().command {
+        Command::Run {
+            world,
+            output,
+            no_record,
+            json,
+            overrides,
+        } => run_command(&world, output, no_record, json, &overrides),
+        Command::Check { worlds } => check_command(&worlds),
+    }
+}
+
+fn run_command(
+    path: &Path,
+    output: Option<PathBuf>,
+    no_record: bool,
+    json: Option<PathBuf>,
+    overrides: &[Override],
+) -> ExitCode {
+    let world = match load(path, overrides) {
+        Ok(world) => world,
+        Err(errors) => {
+            eprintln!("{errors}");
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    let recording = (!no_record).then(|| {
+        output.unwrap_or_else(|| {
+            let stem = path
+                .file_stem()
+                .map_or_else(|| "world".into(), |s| s.to_owned());
+            PathBuf::from(stem).with_extension("rrd")
+        })
+    });
+    let options = RunOptions {
+        recording,
+        json,
+        progress: std::io::stderr().is_terminal() && std::env::var_os("CI").is_none(),
+    };
+    match run(&world, &options) {
+        Ok(report) => {
+            print!("{}", report.table());
+            match &report.recording {
+                Some(rrd) => println!(
+                    "wall time {:.2} s; recording: {} (open it with `rerun {}`)",
+                    report.wall_time.as_secs_f64(),
+                    rrd.display(),
+                    rrd.display()
+                ),
+                None => println!(
+                    "wall time {:.2} s; no recording",
+                    report.wall_time.as_secs_f64()
+                ),
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e @ RunError::Field(_)) => {
+            eprintln!("error: {}: {e}", path.display());
+            ExitCode::from(BAD_INPUT)
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(FAILED)
+        }
+    }
+}
+
+fn check_command(paths: &[PathBuf]) -> ExitCode {
+    let mut ok = true;
+    for path in paths {
+        match load(path, &[]) {
+            Ok(world) => println!(
+                "{}: ok ({}, {} agent(s), {} wall(s))",
+                path.display(),
+                world.name(),
+                world.agents.len(),
+                world.walls.len()
+            ),
+            Err(errors) => {
+                ok = false;
+                eprintln!("{errors}");
+            }
+        }
+    }
+    if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(BAD_INPUT)
+    }
+}

@@ -1,0 +1,211 @@
+//! What a run reports per agent (design page, "Metrics"), accumulated step by step.
+//!
+//! - `reached`: the final distance to the target is within the 5 % band of the initial one.
+//! - `settling_time`: the time at which the distance last entered the 5 % band and stayed
+//!   there (`None` if it ends outside).
+//! - `contacts`: contact starts reported by Rapier's narrow phase, against anything.
+//! - `min_clearance`: smallest parry distance from the agent's disc to any wall.
+//! - `max_deviation` (`δ_m`): largest distance from the dynamic path to the kinematic path.
+//! - `peak_force`, `control_variation` (`Σ|F_k − F_{k−1}|`), `peak_speed`, `path_length`.
+
+use nalgebra::Vector2;
+use serde::Serialize;
+
+use crate::field::Streamline;
+
+/// The width of the settling band, as a fraction of the initial distance to the target.
+pub const SETTLING_BAND: f64 = 0.05;
+
+/// One agent's summary, with the key names of `--json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// The agent's name.
+    pub name: String,
+    /// Whether the final distance is within the settling band.
+    pub reached: bool,
+    /// Settling time, s; `None` if the agent never settled.
+    pub settling_time: Option<f64>,
+    /// Final distance to the target, m.
+    pub final_error: f64,
+    /// Number of contact starts.
+    pub contacts: usize,
+    /// Smallest distance from the agent's shape to any wall, m.
+    pub min_clearance: f64,
+    /// `δ_m`: largest distance from the dynamic to the kinematic path, m.
+    pub max_deviation: f64,
+    /// Length of the dynamic path, m.
+    pub path_length: f64,
+    /// Largest control force magnitude, N.
+    pub peak_force: f64,
+    /// Total variation of the control force, N.
+    pub control_variation: f64,
+    /// Largest speed, m/s.
+    pub peak_speed: f64,
+}
+
+/// Accumulates one agent's metrics over a run.
+#[derive(Debug, Clone)]
+pub struct Metrics {
+    name: String,
+    target: Vector2<f64>,
+    band: f64,
+    last_outside: Option<f64>,
+    settled_at: Option<f64>,
+    final_distance: f64,
+    contacts: usize,
+    min_clearance: f64,
+    path: Vec<[f64; 2]>,
+    path_length: f64,
+    peak_force: f64,
+    control_variation: f64,
+    last_force: Option<Vector2<f64>>,
+    peak_speed: f64,
+}
+
+impl Metrics {
+    /// Starts the record of an agent at `start` heading for `target`.
+    pub fn new(name: &str, start: [f64; 2], target: [f64; 2]) -> Self {
+        let (start, target) = (Vector2::from(start), Vector2::from(target));
+        let d0 = (start - target).norm();
+        Self {
+            name: name.to_string(),
+            target,
+            band: SETTLING_BAND * d0,
+            last_outside: (d0 > SETTLING_BAND * d0).then_some(0.0),
+            settled_at: None,
+            final_distance: d0,
+            contacts: 0,
+            min_clearance: f64::INFINITY,
+            path: vec![start.into()],
+            path_length: 0.0,
+            peak_force: 0.0,
+            control_variation: 0.0,
+            last_force: None,
+            peak_speed: 0.0,
+        }
+    }
+
+    /// The half-width of the settling band, m.
+    pub fn band(&self) -> f64 {
+        self.band
+    }
+
+    /// Records the control force applied during the step that starts now.
+    pub fn record_force(&mut self, force: Vector2<f64>) {
+        self.peak_force = self.peak_force.max(force.norm());
+        if let Some(last) = self.last_force {
+            self.control_variation += (force - last).norm();
+        }
+        self.last_force = Some(force);
+    }
+
+    /// Records the state at time `t` (s) after a step.
+    pub fn record_state(
+        &mut self,
+        t: f64,
+        position: Vector2<f64>,
+        velocity: Vector2<f64>,
+        clearance: f64,
+    ) {
+        let d = (position - self.target).norm();
+        if d > self.band {
+            self.last_outside = Some(t);
+            self.settled_at = None;
+        } else if self.settled_at.is_none() {
+            self.settled_at = Some(t);
+        }
+        self.final_distance = d;
+        self.min_clearance = self.min_clearance.min(clearance);
+        let last = Vector2::from(*self.path.last().expect("the path starts with the start"));
+        self.path_length += (position - last).norm();
+        self.path.push(position.into());
+        self.peak_speed = self.peak_speed.max(velocity.norm());
+    }
+
+    /// Counts `n` new contact starts.
+    pub fn record_contacts(&mut self, n: usize) {
+        self.contacts += n;
+    }
+
+    /// The dynamic path so far.
+    pub fn path(&self) -> &[[f64; 2]] {
+        &self.path
+    }
+
+    /// The summary, with `δ_m` measured against `kinematic`.
+    pub fn summary(&self, kinematic: &Streamline) -> Summary {
+        let reached = self.final_distance <= self.band;
+        let max_deviation = self
+            .path
+            .iter()
+            .map(|p| kinematic.distance_to(*p))
+            .fold(0.0, f64::max);
+        Summary {
+            name: self.name.clone(),
+            reached,
+            settling_time: if reached { self.settled_at } else { None },
+            final_error: self.final_distance,
+            contacts: self.contacts,
+            min_clearance: if self.min_clearance.is_finite() {
+                self.min_clearance
+            } else {
+                0.0
+            },
+            max_deviation,
+            path_length: self.path_length,
+            peak_force: self.peak_force,
+            control_variation: self.control_variation,
+            peak_speed: self.peak_speed,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn straight() -> Streamline {
+        Streamline {
+            points: vec![[0.0, 0.0], [10.0, 0.0]],
+            reached: true,
+        }
+    }
+
+    #[test]
+    fn settling_time_is_the_last_entry_into_the_band() {
+        let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0]);
+        let v = Vector2::zeros();
+        for (t, x) in [(1.0, 5.0), (2.0, 9.7), (3.0, 10.6), (4.0, 9.9), (5.0, 10.0)] {
+            m.record_state(t, Vector2::new(x, 0.0), v, 1.0);
+        }
+        let s = m.summary(&straight());
+        assert!(s.reached);
+        assert_eq!(s.settling_time, Some(4.0));
+        assert_eq!(s.final_error, 0.0);
+        assert!((s.path_length - (5.0 + 4.7 + 0.9 + 0.7 + 0.1)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_agent_that_ends_outside_the_band_never_settled() {
+        let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0]);
+        m.record_state(1.0, Vector2::new(9.9, 0.0), Vector2::zeros(), 1.0);
+        m.record_state(2.0, Vector2::new(8.0, 1.0), Vector2::new(3.0, 4.0), 0.2);
+        let s = m.summary(&straight());
+        assert!(!s.reached);
+        assert_eq!(s.settling_time, None);
+        assert_eq!(s.max_deviation, 1.0);
+        assert_eq!(s.peak_speed, 5.0);
+        assert_eq!(s.min_clearance, 0.2);
+    }
+
+    #[test]
+    fn control_variation_sums_force_changes() {
+        let mut m = Metrics::new("a", [0.0, 0.0], [1.0, 0.0]);
+        for f in [[1.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 2.0]] {
+            m.record_force(Vector2::from(f));
+        }
+        let s = m.summary(&straight());
+        assert_eq!(s.control_variation, 3.0);
+        assert_eq!(s.peak_force, 2.0);
+    }
+}

@@ -1,0 +1,81 @@
+//! The potential as a picture: `log10(1 - V)` through a perceptual colour map.
+
+use crate::field::HarmonicField;
+
+/// Colour of blocked cells.
+const BLOCKED: [u8; 3] = [70, 70, 70];
+/// Colour of free cells that cannot reach the target.
+const UNREACHABLE: [u8; 3] = [0, 0, 0];
+
+/// The agent's field as RGB bytes, row `j` of the image being grid row `j` (y up in the world;
+/// the recording's transforms put it the right way up), and the image's `[width, height]`.
+pub fn potential_image(field: &HarmonicField) -> (Vec<u8>, [u32; 2]) {
+    let grid = *field.grid();
+    let w = field.sampler.w_cells();
+    let reachable = field.sampler.reachable_cells();
+    let logs: Vec<f64> = w
+        .iter()
+        .zip(reachable)
+        .filter(|&(w, r)| *r && *w > 0.0)
+        .map(|(w, _)| w.log10())
+        .collect();
+    let lo = logs.iter().copied().fold(0.0_f64, f64::min);
+    let mut rgb = Vec::with_capacity(grid.len() * 3);
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            let k = grid.index(i, j);
+            let colour = if field.blocked[k] {
+                BLOCKED
+            } else if !reachable[k] || w[k] <= 0.0 {
+                UNREACHABLE
+            } else {
+                let t = if lo < 0.0 {
+                    1.0 - w[k].log10() / lo
+                } else {
+                    1.0
+                };
+                viridis(t)
+            };
+            rgb.extend_from_slice(&colour);
+        }
+    }
+    (rgb, [grid.nx as u32, grid.ny as u32])
+}
+
+/// The viridis colour map at `t ∈ [0, 1]` (piecewise linear through 9 of its stops).
+pub fn viridis(t: f64) -> [u8; 3] {
+    const STOPS: [[f64; 3]; 9] = [
+        [68.0, 1.0, 84.0],
+        [71.0, 44.0, 122.0],
+        [59.0, 81.0, 139.0],
+        [44.0, 113.0, 142.0],
+        [33.0, 144.0, 141.0],
+        [39.0, 173.0, 129.0],
+        [92.0, 200.0, 99.0],
+        [170.0, 220.0, 50.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * (STOPS.len() - 1) as f64;
+    let k = (x.floor() as usize).min(STOPS.len() - 2);
+    let f = x - k as f64;
+    let mix = |c: usize| (STOPS[k][c] + (STOPS[k + 1][c] - STOPS[k][c]) * f).round() as u8;
+    [mix(0), mix(1), mix(2)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn viridis_ends_and_clamps() {
+        assert_eq!(viridis(0.0), [68, 1, 84]);
+        assert_eq!(viridis(1.0), [253, 231, 37]);
+        assert_eq!(viridis(7.0), viridis(1.0));
+        assert_eq!(viridis(f64::NAN), viridis(0.0));
+    }
+}

@@ -1,0 +1,176 @@
+//! Running a world headlessly: simulate to the world's duration, record, summarize.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+use crate::field::FieldError;
+use crate::metrics::Summary;
+use crate::record::{RecordError, Recorder};
+use crate::sim::Simulation;
+use crate::world::World;
+
+/// What a run writes.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Where to write the recording; `None` records nothing.
+    pub recording: Option<PathBuf>,
+    /// Where to write the JSON summary; `None` writes none.
+    pub json: Option<PathBuf>,
+    /// Show a progress bar on standard error.
+    pub progress: bool,
+}
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// An agent's field could not be built (bad input).
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    /// The recording could not be written.
+    #[error(transparent)]
+    Record(#[from] RecordError),
+    /// Writing to the recording failed mid-run.
+    #[error("writing the recording failed: {0}")]
+    Stream(#[from] rerun::RecordingStreamError),
+    /// The JSON summary could not be written.
+    #[error("cannot write the summary {path}: {source}")]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+}
+
+/// The outcome of a run.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// The world's name.
+    pub world: String,
+    /// One summary per agent, in the world file's order.
+    pub agents: Vec<Summary>,
+    /// Wall-clock time of the whole run (fields, simulation, recording).
+    #[serde(skip)]
+    pub wall_time: Duration,
+    /// The recording written, if any.
+    #[serde(skip)]
+    pub recording: Option<PathBuf>,
+}
+
+/// Simulates `world` to its duration.
+pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
+    let started = Instant::now();
+    let mut sim = Simulation::new(world)?;
+    let mut recorder = match &options.recording {
+        Some(path) => {
+            let mut r = Recorder::create(path, world.name())?;
+            if let Err(e) = r.log_setup(&sim) {
+                r.abandon();
+                return Err(e.into());
+            }
+            Some(r)
+        }
+        None => None,
+    };
+    let bar = options.progress.then(|| {
+        let bar = indicatif::ProgressBar::new(world.steps() as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} steps ({eta})")
+                .expect("a valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_message(format!("simulating {}", world.name()));
+        bar
+    });
+    while !sim.finished() {
+        let states = sim.step();
+        if let Some(r) = &mut recorder {
+            if let Err(e) = r.log_step(&sim, &states) {
+                recorder.take().expect("present").abandon();
+                return Err(e.into());
+            }
+        }
+        if let Some(bar) = &bar {
+            bar.inc(1);
+        }
+    }
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let recording = recorder.map(Recorder::finish).transpose()?;
+    let report = Report {
+        world: world.name().to_string(),
+        agents: sim.summaries(),
+        wall_time: started.elapsed(),
+        recording,
+    };
+    if let Some(path) = &options.json {
+        write_atomically(path, report.to_json().as_bytes()).map_err(|source| RunError::Json {
+            path: path.clone(),
+            source,
+        })?;
+    }
+    Ok(report)
+}
+
+/// Writes `bytes` to a temporary file beside `path`, then renames it into place.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut partial = path.as_os_str().to_owned();
+    partial.push(".partial");
+    let partial = PathBuf::from(partial);
+    let result = std::fs::File::create(&partial)
+        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
+        .and_then(|()| std::fs::rename(&partial, path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&partial);
+    }
+    result
+}
+
+impl Report {
+    /// `{"world": NAME, "agents": [{"name": …, "reached": …, …}]}`, pretty-printed.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("summaries are plain data") + "\n"
+    }
+
+    /// The summary as a plain-text table, one row per agent.
+    pub fn table(&self) -> String {
+        let mut out = format!(
+            "{:<12} {:>7} {:>9} {:>9} {:>8} {:>9} {:>9} {:>8} {:>8} {:>9} {:>8}\n",
+            "agent",
+            "reached",
+            "settle_s",
+            "error_m",
+            "contacts",
+            "clear_m",
+            "dev_m",
+            "path_m",
+            "peak_N",
+            "var_N",
+            "vmax"
+        );
+        for s in &self.agents {
+            let settle = s
+                .settling_time
+                .map_or_else(|| "never".to_string(), |t| format!("{t:.2}"));
+            out += &format!(
+                "{:<12} {:>7} {:>9} {:>9.3} {:>8} {:>9.3} {:>9.3} {:>8.2} {:>8.2} {:>9.2} {:>8.2}\n",
+                s.name,
+                if s.reached { "yes" } else { "no" },
+                settle,
+                s.final_error,
+                s.contacts,
+                s.min_clearance,
+                s.max_deviation,
+                s.path_length,
+                s.peak_force,
+                s.control_variation,
+                s.peak_speed
+            );
+        }
+        out
+    }
+}

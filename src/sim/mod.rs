@@ -1,0 +1,224 @@
+//! The simulation: a Rapier world with the walls as fixed colliders and each agent as a dynamic
+//! disc, and the step loop that closes the control loop through it.
+//!
+//! Every step, for every agent: read its position and velocity from Rapier, sample the
+//! gradient of its field there, compute the control force, reset the body's forces and apply
+//! the new one (Rapier's user forces persist across steps otherwise), then step Rapier once.
+//! Rapier's narrow phase then says which pairs touch.
+
+mod physics;
+
+use std::collections::HashSet;
+
+use nalgebra::Vector2;
+use parry2d::math::Pose;
+use parry2d::shape::Ball;
+use rapier2d::prelude::{ColliderHandle, PhysicsWorld, RigidBodyHandle};
+
+pub use physics::{from_rapier, to_rapier};
+
+use crate::control::{Controller, unit};
+use crate::field::{FieldError, HarmonicField, Streamline};
+use crate::metrics::{Metrics, Summary};
+use crate::world::{Agent, WallShape, World, all_wall_shapes};
+
+/// A pair counts as touching when Rapier has an active contact between them whose distance is
+/// at most this, m. Rapier also keeps speculative contacts up to its prediction distance
+/// (2 cm) ahead of a touch; those are not touches.
+pub const CONTACT_TOLERANCE: f64 = 1e-3;
+
+/// One agent in a running simulation.
+pub struct AgentRun {
+    /// The agent as the world file describes it.
+    pub agent: Agent,
+    /// Its harmonic field.
+    pub field: HarmonicField,
+    /// Its kinematic path (the streamline from its start).
+    pub kinematic: Streamline,
+    /// Its controller.
+    pub controller: Controller<2>,
+    /// Its metrics so far.
+    pub metrics: Metrics,
+    body: RigidBodyHandle,
+    collider: ColliderHandle,
+    touching: HashSet<ColliderHandle>,
+}
+
+/// What happened to one agent in the last step, for recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AgentState {
+    /// Position, m.
+    pub position: Vector2<f64>,
+    /// Velocity, m/s.
+    pub velocity: Vector2<f64>,
+    /// The control force applied during the step, N.
+    pub force: Vector2<f64>,
+    /// Distance to the target, m.
+    pub distance: f64,
+    /// Speed along the guidance, `-uᵀv` with `u = ∇V/|∇V|` (the paper's "radial speed": the
+    /// component of motion along the radial basis of the field's coordinates, figure 12), m/s.
+    pub radial_speed: f64,
+    /// The potential `V` at the position.
+    pub potential: f64,
+    /// Distance from the agent's disc to the nearest wall, m.
+    pub clearance: f64,
+    /// Points where the agent touches something, m.
+    pub contact_points: Vec<Vector2<f64>>,
+}
+
+/// A running simulation.
+pub struct Simulation {
+    /// The world being simulated.
+    pub world: World,
+    /// The walls' shapes, in the order of their colliders.
+    pub walls: Vec<WallShape>,
+    /// The agents.
+    pub agents: Vec<AgentRun>,
+    physics: PhysicsWorld,
+    time: f64,
+    steps: usize,
+}
+
+impl Simulation {
+    /// Builds the Rapier world and solves every agent's field.
+    pub fn new(world: &World) -> Result<Self, FieldError> {
+        let mut physics = physics::empty_world(world.dt);
+        let walls = all_wall_shapes(world);
+        physics::insert_walls(&mut physics, &walls);
+        let mut agents = Vec::with_capacity(world.agents.len());
+        for agent in &world.agents {
+            let field = HarmonicField::solve(world, agent)?;
+            let kinematic = field.streamline(agent.start);
+            let (body, collider) = physics::insert_agent(&mut physics, agent);
+            agents.push(AgentRun {
+                controller: Controller::from_settings(&agent.controller, world.field.guidance),
+                metrics: Metrics::new(&agent.name, agent.start, agent.target),
+                agent: agent.clone(),
+                field,
+                kinematic,
+                body,
+                collider,
+                touching: HashSet::new(),
+            });
+        }
+        Ok(Self {
+            world: world.clone(),
+            walls,
+            agents,
+            physics,
+            time: 0.0,
+            steps: 0,
+        })
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Whether the run has reached the world's duration.
+    pub fn finished(&self) -> bool {
+        self.steps >= self.world.steps()
+    }
+
+    /// Advances one physics step and returns each agent's state after it.
+    pub fn step(&mut self) -> Vec<AgentState> {
+        let mut forces = Vec::with_capacity(self.agents.len());
+        for run in &mut self.agents {
+            let body = &mut self.physics.bodies[run.body];
+            let x = from_rapier(body.translation());
+            let v = from_rapier(body.linvel());
+            let distance = (x - Vector2::from(run.agent.target)).norm();
+            let g = run.field.gradient(x.into());
+            let force = run.controller.force(distance, &v, g.as_ref());
+            body.reset_forces(false);
+            body.add_force(to_rapier(force), true);
+            run.metrics.record_force(force);
+            forces.push(force);
+        }
+        self.physics.step();
+        self.steps += 1;
+        self.time = self.steps as f64 * self.world.dt;
+
+        let mut states = Vec::with_capacity(self.agents.len());
+        for (run, force) in self.agents.iter_mut().zip(forces) {
+            let body = &self.physics.bodies[run.body];
+            let position = from_rapier(body.translation());
+            let velocity = from_rapier(body.linvel());
+            let p: [f64; 2] = position.into();
+            let distance = (position - Vector2::from(run.agent.target)).norm();
+            let radial_speed = run
+                .field
+                .gradient(p)
+                .and_then(|g| unit(&g))
+                .map_or(0.0, |u| -u.dot(&velocity));
+            let clearance = clearance(&self.walls, position, run.agent.radius);
+
+            // Contact starts: pairs touching now that were not touching after the last step.
+            let mut now = HashSet::new();
+            let mut contact_points = Vec::new();
+            for pair in self.physics.narrow_phase.contact_pairs_with(run.collider) {
+                if !pair.has_any_active_contact() {
+                    continue;
+                }
+                let other = if pair.collider1 == run.collider {
+                    pair.collider2
+                } else {
+                    pair.collider1
+                };
+                for manifold in pair.manifolds() {
+                    if manifold
+                        .points
+                        .iter()
+                        .any(|c| f64::from(c.dist) <= CONTACT_TOLERANCE)
+                    {
+                        // The normal points from collider 1 to collider 2.
+                        let n = from_rapier(manifold.data.normal);
+                        let side = if pair.collider1 == run.collider {
+                            1.0
+                        } else {
+                            -1.0
+                        };
+                        contact_points.push(position + n * (side * run.agent.radius));
+                        now.insert(other);
+                    }
+                }
+            }
+            let started = now.difference(&run.touching).count();
+            run.touching = now;
+            run.metrics.record_contacts(started);
+            run.metrics
+                .record_state(self.time, position, velocity, clearance);
+            states.push(AgentState {
+                position,
+                velocity,
+                force,
+                distance,
+                radial_speed,
+                potential: run.field.potential(p),
+                clearance,
+                contact_points,
+            });
+        }
+        states
+    }
+
+    /// Each agent's summary so far.
+    pub fn summaries(&self) -> Vec<Summary> {
+        self.agents
+            .iter()
+            .map(|a| a.metrics.summary(&a.kinematic))
+            .collect()
+    }
+}
+
+/// Distance from a disc of `radius` at `position` to the nearest wall, m (0 when overlapping).
+pub fn clearance(walls: &[WallShape], position: Vector2<f64>, radius: f64) -> f64 {
+    let disc = Ball::new(radius as f32);
+    let pose = Pose::from_translation(to_rapier(position));
+    walls
+        .iter()
+        .filter_map(|w| parry2d::query::distance(&pose, &disc, &w.pose, w.shape.as_ref()).ok())
+        .map(|d| f64::from(d.distance))
+        .fold(f64::INFINITY, f64::min)
+}

@@ -1,0 +1,59 @@
+//! Building the Rapier world from a world file, and the one conversion between the control
+//! laws' nalgebra `f64` vectors and Rapier's `glam` `f32` ones.
+
+use nalgebra::Vector2;
+use rapier2d::prelude::*;
+
+use crate::world::{Agent, WallShape};
+
+/// Rapier vector → control-law vector.
+pub fn from_rapier(v: Vector) -> Vector2<f64> {
+    Vector2::new(f64::from(v.x), f64::from(v.y))
+}
+
+/// Control-law vector → Rapier vector.
+pub fn to_rapier(v: Vector2<f64>) -> Vector {
+    Vector::new(v.x as f32, v.y as f32)
+}
+
+/// A Rapier world with no gravity and the given step.
+pub fn empty_world(dt: f64) -> PhysicsWorld {
+    let mut physics = PhysicsWorld::default();
+    physics.gravity = Vector::ZERO;
+    physics.integration_parameters.dt = dt as f32;
+    physics
+}
+
+/// Inserts the walls as colliders of one fixed body and returns their handles, in order.
+pub fn insert_walls(physics: &mut PhysicsWorld, walls: &[WallShape]) -> Vec<ColliderHandle> {
+    let ground = physics.insert_body(RigidBodyBuilder::fixed());
+    walls
+        .iter()
+        .map(|w| {
+            let collider = ColliderBuilder::new(w.shape.clone())
+                .position(w.pose)
+                .friction(0.0);
+            physics.insert_collider(collider, Some(ground))
+        })
+        .collect()
+}
+
+/// Inserts an agent: a dynamic disc of the agent's radius and mass that does not rotate, never
+/// sleeps (its control force changes every step) and uses continuous collision detection (a
+/// fast body must not tunnel through a thin wall). Contacts are frictionless and inelastic:
+/// a touch is a failure to be counted, not a dynamics to be modelled.
+pub fn insert_agent(
+    physics: &mut PhysicsWorld,
+    agent: &Agent,
+) -> (RigidBodyHandle, ColliderHandle) {
+    let body = RigidBodyBuilder::dynamic()
+        .translation(Vector::new(agent.start[0] as f32, agent.start[1] as f32))
+        .lock_rotations()
+        .can_sleep(false)
+        .ccd_enabled(true);
+    let collider = ColliderBuilder::ball(agent.radius as f32)
+        .mass(agent.mass as f32)
+        .friction(0.0)
+        .restitution(0.0);
+    physics.insert(body, collider)
+}

@@ -1,0 +1,351 @@
+//! Reading a world file: TOML text → `--set` overrides → serde → validation, with every error
+//! pointing at a file, a line and a key.
+//!
+//! The file is parsed twice: once with `toml_edit`, which keeps the span of every key so that a
+//! problem found later (by serde or by validation) can be traced back to its line, and once with
+//! serde into [`World`]. Overrides are applied to the `toml_edit` document, so a value set on the
+//! command line goes through exactly the same checks as one written in the file; an error it
+//! causes names the `--set` rather than a line of the file.
+
+use std::ops::Range;
+use std::path::Path;
+use std::str::FromStr;
+
+use toml_edit::{DocumentMut, Item, TableLike, Value};
+
+use super::error::{WorldError, WorldErrors, line_column};
+use super::schema::World;
+use super::validate::validate;
+
+/// One `--set KEY=VALUE` override: a dotted path (array items by index) and a TOML value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Override {
+    /// Dotted path, e.g. `agents.0.controller.b`.
+    pub path: String,
+    /// The value as written; parsed as TOML (`0.7`, `"gradient"`, `[1, 2]`), or taken as a
+    /// bare string when it is not valid TOML (`gradient`).
+    pub value: String,
+}
+
+impl FromStr for Override {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let (path, value) = s
+            .split_once('=')
+            .ok_or_else(|| format!("`{s}` is not KEY=VALUE"))?;
+        let path = path.trim();
+        if path.is_empty() || path.split('.').any(str::is_empty) {
+            return Err(format!(
+                "`{path}` is not a dotted key path like agents.0.controller.b"
+            ));
+        }
+        Ok(Self {
+            path: path.to_string(),
+            value: value.trim().to_string(),
+        })
+    }
+}
+
+impl std::fmt::Display for Override {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}={}", self.path, self.value)
+    }
+}
+
+/// Reads, overrides, parses and validates a world file. The world's `name` defaults to the
+/// file stem. Every problem found is returned, not only the first.
+pub fn load(path: &Path, overrides: &[Override]) -> Result<World, WorldErrors> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        WorldErrors(vec![WorldError {
+            file: path.to_path_buf(),
+            location: None,
+            key: None,
+            message: format!("cannot read the file: {e}"),
+        }])
+    })?;
+    load_str(&text, path, overrides)
+}
+
+/// Like [`load`], for text already in memory; `file` is used for messages and the default name.
+pub fn load_str(text: &str, file: &Path, overrides: &[Override]) -> Result<World, WorldErrors> {
+    let error =
+        |location: Option<(usize, usize)>, key: Option<String>, message: String| WorldError {
+            file: file.to_path_buf(),
+            location,
+            key,
+            message,
+        };
+    // The file as written: every error here has a line.
+    let world = parse(text, file).map_err(|problems| {
+        WorldErrors(
+            problems
+                .into_iter()
+                .map(|p| error(p.span.map(|s| line_column(text, s.start)), p.key, p.message))
+                .collect(),
+        )
+    })?;
+    if overrides.is_empty() {
+        return Ok(world);
+    }
+    // With the overrides: a problem is the override's when its key is (under) an overridden
+    // path; otherwise it is located in the original text by its key.
+    let mut doc = DocumentMut::from_str(text).expect("the text parsed above");
+    for o in overrides {
+        apply_override(&mut doc, o).map_err(|m| {
+            WorldErrors(vec![error(
+                None,
+                Some(o.path.clone()),
+                format!("--set {o}: {m}"),
+            )])
+        })?;
+    }
+    let edited = doc.to_string();
+    parse(&edited, file).map_err(|problems| {
+        let original = Spans::of(text);
+        WorldErrors(
+            problems
+                .into_iter()
+                .map(|p| {
+                    let culprit = p.key.as_deref().and_then(|k| {
+                        overrides
+                            .iter()
+                            .find(|o| k.starts_with(&o.path) || o.path.starts_with(k))
+                    });
+                    match culprit {
+                        Some(o) => error(None, p.key, format!("--set {o}: {}", p.message)),
+                        None => {
+                            let at = p.key.as_deref().and_then(|k| original.span_of(k));
+                            error(at.map(|s| line_column(text, s.start)), p.key, p.message)
+                        }
+                    }
+                })
+                .collect(),
+        )
+    })
+}
+
+/// A problem found while parsing or validating, located by span in the text that was parsed.
+struct Problem {
+    span: Option<Range<usize>>,
+    key: Option<String>,
+    message: String,
+}
+
+/// TOML syntax → serde → default name → validation.
+fn parse(text: &str, file: &Path) -> Result<World, Vec<Problem>> {
+    let spans = match toml_edit::Document::parse(text) {
+        Ok(doc) => Spans::from_doc(&doc),
+        Err(e) => {
+            return Err(vec![Problem {
+                span: e.span(),
+                key: None,
+                message: format!("TOML syntax error: {}", e.message().trim()),
+            }]);
+        }
+    };
+    let mut world: World = toml::from_str(text).map_err(|e| {
+        let span = e.span();
+        let key = span.as_ref().and_then(|s| spans.key_at(s.start));
+        vec![Problem {
+            span,
+            key,
+            message: e.message().trim().to_string(),
+        }]
+    })?;
+    if world.name.is_none() {
+        world.name = Some(
+            file.file_stem()
+                .map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned()),
+        );
+    }
+    let issues = validate(&world);
+    if issues.is_empty() {
+        Ok(world)
+    } else {
+        Err(issues
+            .into_iter()
+            .map(|(key, message)| Problem {
+                span: spans.span_of(&key),
+                key: Some(key),
+                message,
+            })
+            .collect())
+    }
+}
+
+/// The span of every key path in a TOML document (`agents.0.controller.b`).
+struct Spans(Vec<(String, Range<usize>)>);
+
+impl Spans {
+    fn of(text: &str) -> Self {
+        toml_edit::Document::parse(text).map_or(Spans(Vec::new()), |d| Self::from_doc(&d))
+    }
+
+    fn from_doc(doc: &toml_edit::Document<&str>) -> Self {
+        let mut out = Vec::new();
+        walk_table(doc.as_table(), "", &mut out);
+        Spans(out)
+    }
+
+    /// The innermost key whose span contains `offset`.
+    fn key_at(&self, offset: usize) -> Option<String> {
+        self.0
+            .iter()
+            .filter(|(_, r)| r.start <= offset && offset < r.end.max(r.start + 1))
+            .min_by_key(|(_, r)| r.len())
+            .map(|(k, _)| k.clone())
+    }
+
+    /// The span of `path`, or of its nearest ancestor in the document.
+    fn span_of(&self, path: &str) -> Option<Range<usize>> {
+        let mut path = path;
+        loop {
+            if let Some((_, r)) = self.0.iter().find(|(k, _)| k == path) {
+                return Some(r.clone());
+            }
+            path = &path[..path.rfind('.')?];
+        }
+    }
+}
+
+fn join(prefix: &str, key: &str) -> String {
+    if prefix.is_empty() {
+        key.to_string()
+    } else {
+        format!("{prefix}.{key}")
+    }
+}
+
+fn walk_table(table: &dyn TableLike, prefix: &str, out: &mut Vec<(String, Range<usize>)>) {
+    for (name, item) in table.iter() {
+        let path = join(prefix, name);
+        let key_span = table.key(name).and_then(|k| k.span());
+        walk_item(item, &path, key_span, out);
+    }
+}
+
+fn walk_item(
+    item: &Item,
+    path: &str,
+    key_span: Option<Range<usize>>,
+    out: &mut Vec<(String, Range<usize>)>,
+) {
+    let with_key = |span: Option<Range<usize>>| match (key_span.clone(), span) {
+        (Some(k), Some(v)) => Some(k.start.min(v.start)..k.end.max(v.end)),
+        (k, v) => v.or(k),
+    };
+    match item {
+        Item::None => {}
+        Item::Value(value) => walk_value(value, path, with_key(value.span()), out),
+        Item::Table(t) => {
+            if let Some(span) = with_key(t.span()) {
+                out.push((path.to_string(), span));
+            }
+            walk_table(t, path, out);
+        }
+        Item::ArrayOfTables(a) => {
+            for (i, t) in a.iter().enumerate() {
+                let path = format!("{path}.{i}");
+                if let Some(span) = t.span() {
+                    out.push((path.clone(), span));
+                }
+                walk_table(t, &path, out);
+            }
+        }
+    }
+}
+
+fn walk_value(
+    value: &Value,
+    path: &str,
+    span: Option<Range<usize>>,
+    out: &mut Vec<(String, Range<usize>)>,
+) {
+    if let Some(span) = span {
+        out.push((path.to_string(), span));
+    }
+    match value {
+        Value::InlineTable(t) => walk_table(t, path, out),
+        Value::Array(a) => {
+            for (i, v) in a.iter().enumerate() {
+                walk_value(v, &format!("{path}.{i}"), v.span(), out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Sets `o.path` to `o.value` in the document. Tables on the way are created when missing (so
+/// `field.guidance` works in a file without `[field]`); array items must exist.
+fn apply_override(doc: &mut DocumentMut, o: &Override) -> Result<(), String> {
+    let value = parse_value(&o.value);
+    let segments: Vec<&str> = o.path.split('.').collect();
+    set_in_table(doc.as_table_mut(), &segments, value)
+}
+
+fn parse_value(text: &str) -> Value {
+    format!("v = {text}")
+        .parse::<DocumentMut>()
+        .ok()
+        .and_then(|d| d.get("v").and_then(|i| i.as_value().cloned()))
+        .unwrap_or_else(|| Value::from(text))
+}
+
+fn set_in_table(table: &mut dyn TableLike, segments: &[&str], value: Value) -> Result<(), String> {
+    let (head, rest) = segments.split_first().ok_or("empty key path")?;
+    if rest.is_empty() {
+        table.insert(head, Item::Value(value));
+        return Ok(());
+    }
+    if table.get(head).is_none() {
+        if rest[0].parse::<usize>().is_ok() {
+            return Err(format!("there is no array `{head}` to index"));
+        }
+        let mut new = toml_edit::Table::new();
+        new.set_implicit(true);
+        table.insert(head, Item::Table(new));
+    }
+    let item = table.get_mut(head).expect("inserted above");
+    set_in_item(item, head, rest, value)
+}
+
+fn set_in_item(item: &mut Item, name: &str, segments: &[&str], value: Value) -> Result<(), String> {
+    let index = || -> Result<usize, String> {
+        segments[0].parse().map_err(|_| {
+            format!(
+                "`{name}` is an array: index it with a number, not `{}`",
+                segments[0]
+            )
+        })
+    };
+    match item {
+        Item::Table(t) => set_in_table(t, segments, value),
+        Item::Value(Value::InlineTable(t)) => set_in_table(t, segments, value),
+        Item::ArrayOfTables(a) => {
+            let (i, len) = (index()?, a.len());
+            let t = a
+                .get_mut(i)
+                .ok_or_else(|| format!("`{name}` has {len} items, there is no item {i}"))?;
+            if segments.len() == 1 {
+                return Err(format!("`{name}.{i}` is a table: set one of its keys"));
+            }
+            set_in_table(t, &segments[1..], value)
+        }
+        Item::Value(Value::Array(a)) => {
+            let (i, len) = (index()?, a.len());
+            if i >= len {
+                return Err(format!("`{name}` has {len} items, there is no item {i}"));
+            }
+            if segments.len() == 1 {
+                a.replace(i, value);
+                return Ok(());
+            }
+            match a.get_mut(i) {
+                Some(Value::InlineTable(t)) => set_in_table(t, &segments[1..], value),
+                _ => Err(format!("`{name}.{i}` is a value, not a table")),
+            }
+        }
+        _ => Err(format!("`{name}` is a value, not a table")),
+    }
+}

@@ -1,0 +1,31 @@
+//! The world file: its schema, loading (with `--set` overrides) and validation.
+//!
+//! A world is a box with walls and one or more agents, each a disc with a start, a target and
+//! a controller. See `worlds/README.md` for the format.
+
+mod error;
+mod load;
+mod schema;
+mod shapes;
+mod validate;
+
+pub use error::{WorldError, WorldErrors};
+pub use load::{Override, load, load_str};
+pub use schema::{
+    Agent, ControllerKind, ControllerSettings, FieldSettings, GuidanceKind, OUTER_WALL_THICKNESS,
+    Wall, World,
+};
+pub use shapes::{WallShape, all_wall_shapes, all_walls, outer_walls, wall_shape};
+pub use validate::{MAX_CELLS, validate};
+
+impl World {
+    /// The world's name (the file stem unless the file sets one).
+    pub fn name(&self) -> &str {
+        self.name.as_deref().unwrap_or("world")
+    }
+
+    /// Number of physics steps in a run.
+    pub fn steps(&self) -> usize {
+        (self.duration / self.dt).round() as usize
+    }
+}

@@ -1,0 +1,188 @@
+//! The world file's schema: plain serde structs, one per TOML table, unknown keys rejected.
+//!
+//! Defaults live here, next to the field they belong to, so that `worlds/README.md` and the
+//! code cannot disagree about them for long: every default is a named function below.
+
+use serde::{Deserialize, Serialize};
+
+/// A whole world: the box, its walls, its agents and how long to simulate them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct World {
+    /// Name of the world, used in the recording and the summary. Default: the file stem.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// The box `[0, W] × [0, H]`, in metres.
+    pub size: [f64; 2],
+    /// Add four walls of [`OUTER_WALL_THICKNESS`] just inside the box.
+    #[serde(default = "default_true")]
+    pub walls_around: bool,
+    /// Physics step, s.
+    #[serde(default = "default_dt")]
+    pub dt: f64,
+    /// Simulated time, s.
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+    /// Seed for everything random in a run (a run is deterministic for a given file and seed).
+    #[serde(default)]
+    pub seed: u64,
+    /// How the guidance field is built.
+    #[serde(default)]
+    pub field: FieldSettings,
+    /// Static obstacles.
+    #[serde(default)]
+    pub walls: Vec<Wall>,
+    /// The controlled bodies (at least one).
+    #[serde(default)]
+    pub agents: Vec<Agent>,
+}
+
+/// Thickness of the walls that `walls_around = true` adds, m.
+pub const OUTER_WALL_THICKNESS: f64 = 0.1;
+
+/// The `[field]` table: grid and guidance settings shared by all agents.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FieldSettings {
+    /// Grid spacing, m.
+    #[serde(default = "default_cell")]
+    pub cell: f64,
+    /// How the field's gradient becomes a guidance force.
+    #[serde(default)]
+    pub guidance: GuidanceKind,
+    /// Relative per-cell tolerance at which the Laplace solver stops.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+}
+
+impl Default for FieldSettings {
+    fn default() -> Self {
+        Self {
+            cell: default_cell(),
+            guidance: GuidanceKind::default(),
+            tolerance: default_tolerance(),
+        }
+    }
+}
+
+/// How the guidance force is derived from the gradient `g = ∇V` (see the design page).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GuidanceKind {
+    /// `F_g = -K · g/|g|`, tapered inside the capture radius: constant thrust along the streamline.
+    #[default]
+    Normalized,
+    /// `F_g = -K · g`: the paper's equations, for which Proposition 1's energy argument holds.
+    Gradient,
+}
+
+/// One static wall: a fixed Rapier collider.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "shape", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Wall {
+    /// A rectangle, possibly rotated.
+    Box {
+        /// Centre, m.
+        center: [f64; 2],
+        /// Half width and half height, m.
+        half_extents: [f64; 2],
+        /// Rotation about the centre, rad (counter-clockwise).
+        #[serde(default)]
+        angle: f64,
+    },
+    /// A thick segment from `a` to `b`: a capsule of radius `thickness / 2`.
+    Segment {
+        /// First end point, m.
+        a: [f64; 2],
+        /// Second end point, m.
+        b: [f64; 2],
+        /// Full thickness, m.
+        thickness: f64,
+    },
+    /// A solid disc.
+    Disc {
+        /// Centre, m.
+        center: [f64; 2],
+        /// Radius, m.
+        radius: f64,
+    },
+    /// A convex polygon, vertices counter-clockwise.
+    Polygon {
+        /// Vertices, m.
+        points: Vec<[f64; 2]>,
+    },
+}
+
+/// One agent: a dynamic disc with its own target and controller.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Agent {
+    /// Name, unique in the world; used in entity paths and the summary.
+    pub name: String,
+    /// Start position, m.
+    pub start: [f64; 2],
+    /// Target position, m.
+    pub target: [f64; 2],
+    /// Disc radius, m.
+    #[serde(default = "default_radius")]
+    pub radius: f64,
+    /// Mass, kg.
+    #[serde(default = "default_mass")]
+    pub mass: f64,
+    /// The control law.
+    pub controller: ControllerSettings,
+}
+
+/// The `[agents.controller]` table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerSettings {
+    /// Which damping law turns the guidance into a control force.
+    pub kind: ControllerKind,
+    /// Guidance gain K: N for `normalized` guidance, N·m for `gradient` guidance.
+    #[serde(default = "default_k")]
+    pub k: f64,
+    /// Damping coefficient, N·s/m: `B_d` for NADF, `B` for viscous damping.
+    pub b: f64,
+    /// Radius around the target inside which normalized guidance tapers linearly to zero, m.
+    #[serde(default = "default_capture_radius")]
+    pub capture_radius: f64,
+}
+
+/// The damping laws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ControllerKind {
+    /// Nonlinear anisotropic damping (eq. 9–10).
+    Nadf,
+    /// Linear viscous damping (eq. 1).
+    Viscous,
+}
+
+fn default_true() -> bool {
+    true
+}
+fn default_dt() -> f64 {
+    0.01
+}
+fn default_duration() -> f64 {
+    60.0
+}
+fn default_cell() -> f64 {
+    0.05
+}
+fn default_tolerance() -> f64 {
+    1e-9
+}
+fn default_radius() -> f64 {
+    0.2
+}
+fn default_mass() -> f64 {
+    1.0
+}
+fn default_k() -> f64 {
+    1.0
+}
+fn default_capture_radius() -> f64 {
+    0.25
+}

@@ -1,0 +1,89 @@
+//! The walls as parry shapes: the one place where a world file's geometry becomes collider
+//! geometry. The simulation inserts these shapes into Rapier, the field rasterizes them and the
+//! metrics measure clearance against them, so all three see exactly the same walls.
+
+use parry2d::math::{Pose, Vector};
+use parry2d::shape::SharedShape;
+
+use super::schema::{OUTER_WALL_THICKNESS, Wall, World};
+
+/// A wall ready for Rapier and parry: its pose and its shape.
+#[derive(Clone)]
+pub struct WallShape {
+    /// Where the shape sits in the world.
+    pub pose: Pose,
+    /// The shape in its local frame.
+    pub shape: SharedShape,
+}
+
+impl WallShape {
+    /// Distance from a point to the wall, m (0 inside it).
+    pub fn distance_to_point(&self, x: f64, y: f64) -> f64 {
+        f64::from(
+            self.shape
+                .distance_to_point(&self.pose, Vector::new(x as f32, y as f32), true),
+        )
+    }
+}
+
+/// Converts one wall entry into a shape; `None` when parry cannot build it (a degenerate polygon).
+pub fn wall_shape(wall: &Wall) -> Option<WallShape> {
+    let v = |p: [f64; 2]| Vector::new(p[0] as f32, p[1] as f32);
+    Some(match wall {
+        Wall::Box {
+            center,
+            half_extents,
+            angle,
+        } => WallShape {
+            pose: Pose::new(v(*center), *angle as f32),
+            shape: SharedShape::cuboid(half_extents[0] as f32, half_extents[1] as f32),
+        },
+        Wall::Segment { a, b, thickness } => WallShape {
+            pose: Pose::IDENTITY,
+            shape: SharedShape::capsule(v(*a), v(*b), (*thickness / 2.0) as f32),
+        },
+        Wall::Disc { center, radius } => WallShape {
+            pose: Pose::from_translation(v(*center)),
+            shape: SharedShape::ball(*radius as f32),
+        },
+        Wall::Polygon { points } => WallShape {
+            pose: Pose::IDENTITY,
+            shape: SharedShape::convex_polyline(points.iter().map(|p| v(*p)).collect())?,
+        },
+    })
+}
+
+/// The four walls `walls_around = true` adds: boxes of [`OUTER_WALL_THICKNESS`] just inside
+/// `[0, W] × [0, H]`.
+pub fn outer_walls(size: [f64; 2]) -> Vec<Wall> {
+    let [w, h] = size;
+    let t = OUTER_WALL_THICKNESS / 2.0;
+    let wall = |cx: f64, cy: f64, hx: f64, hy: f64| Wall::Box {
+        center: [cx, cy],
+        half_extents: [hx, hy],
+        angle: 0.0,
+    };
+    vec![
+        wall(w / 2.0, t, w / 2.0, t),
+        wall(w / 2.0, h - t, w / 2.0, t),
+        wall(t, h / 2.0, t, h / 2.0),
+        wall(w - t, h / 2.0, t, h / 2.0),
+    ]
+}
+
+/// Every wall of the world, the outer ones first, as shapes. Walls that parry cannot build are
+/// skipped here; validation reports them before a world ever reaches this point.
+pub fn all_wall_shapes(world: &World) -> Vec<WallShape> {
+    all_walls(world).iter().filter_map(wall_shape).collect()
+}
+
+/// Every wall of the world, the outer ones (if any) first.
+pub fn all_walls(world: &World) -> Vec<Wall> {
+    let mut walls = if world.walls_around {
+        outer_walls(world.size)
+    } else {
+        Vec::new()
+    };
+    walls.extend(world.walls.iter().cloned());
+    walls
+}

@@ -1,0 +1,271 @@
+//! Semantic checks that serde cannot express: positive sizes, finite numbers, convex polygons,
+//! agents that start in free space. Each problem is a dotted key path and a message; the loader
+//! turns the path into a line of the file.
+
+use super::schema::{Agent, Wall, World};
+use super::shapes::{outer_walls, wall_shape};
+
+/// The largest grid the field solver accepts, in cells (4096 × 4096). A world whose `size` and
+/// `field.cell` give more cells is rejected: raise `field.cell`, or change this limit and rebuild.
+pub const MAX_CELLS: u64 = 4096 * 4096;
+
+/// Every problem in a parsed world, as `(key path, message)`; empty when the world is valid.
+pub fn validate(world: &World) -> Vec<(String, String)> {
+    let mut issues = Vec::new();
+    let mut bad = |key: String, message: String| issues.push((key, message));
+
+    positive(&mut bad, "size.0", world.size[0]);
+    positive(&mut bad, "size.1", world.size[1]);
+    positive(&mut bad, "dt", world.dt);
+    positive(&mut bad, "duration", world.duration);
+    positive(&mut bad, "field.cell", world.field.cell);
+    if !(world.field.tolerance > 0.0 && world.field.tolerance < 1.0) {
+        bad(
+            "field.tolerance".into(),
+            format!("must be in (0, 1), got {}", world.field.tolerance),
+        );
+    }
+    if world.size.iter().all(|s| s.is_finite() && *s > 0.0)
+        && world.field.cell.is_finite()
+        && world.field.cell > 0.0
+    {
+        let cells =
+            (world.size[0] / world.field.cell).ceil() * (world.size[1] / world.field.cell).ceil();
+        if cells > MAX_CELLS as f64 {
+            bad(
+                "field.cell".into(),
+                format!(
+                    "a {} m cell over a {} × {} m box makes {cells:.0} grid cells, more than the limit of {MAX_CELLS} (4096²); use a larger cell",
+                    world.field.cell, world.size[0], world.size[1]
+                ),
+            );
+        }
+    }
+    if world.dt.is_finite() && world.duration.is_finite() && world.dt > world.duration {
+        bad(
+            "dt".into(),
+            format!(
+                "the step ({} s) is longer than the duration ({} s)",
+                world.dt, world.duration
+            ),
+        );
+    }
+
+    for (i, wall) in world.walls.iter().enumerate() {
+        check_wall(&mut bad, &format!("walls.{i}"), wall);
+    }
+
+    if world.agents.is_empty() {
+        bad(
+            "agents".into(),
+            "a world needs at least one [[agents]] entry".into(),
+        );
+    }
+    for (i, agent) in world.agents.iter().enumerate() {
+        check_agent(&mut bad, world, i, agent);
+    }
+    issues
+}
+
+fn positive(bad: &mut impl FnMut(String, String), key: &str, x: f64) {
+    if !(x.is_finite() && x > 0.0) {
+        bad(
+            key.into(),
+            format!("must be a positive finite number, got {x}"),
+        );
+    }
+}
+
+fn finite_point(bad: &mut impl FnMut(String, String), key: &str, p: [f64; 2]) -> bool {
+    let ok = p.iter().all(|c| c.is_finite());
+    if !ok {
+        bad(
+            key.into(),
+            format!("must be finite, got [{}, {}]", p[0], p[1]),
+        );
+    }
+    ok
+}
+
+fn check_wall(bad: &mut impl FnMut(String, String), key: &str, wall: &Wall) {
+    match wall {
+        Wall::Box {
+            center,
+            half_extents,
+            angle,
+        } => {
+            finite_point(bad, &format!("{key}.center"), *center);
+            positive(bad, &format!("{key}.half_extents.0"), half_extents[0]);
+            positive(bad, &format!("{key}.half_extents.1"), half_extents[1]);
+            if !angle.is_finite() {
+                bad(
+                    format!("{key}.angle"),
+                    format!("must be finite, got {angle}"),
+                );
+            }
+        }
+        Wall::Segment { a, b, thickness } => {
+            let ok = finite_point(bad, &format!("{key}.a"), *a)
+                & finite_point(bad, &format!("{key}.b"), *b);
+            positive(bad, &format!("{key}.thickness"), *thickness);
+            if ok && a == b {
+                bad(
+                    format!("{key}.b"),
+                    "a segment needs two distinct end points".into(),
+                );
+            }
+        }
+        Wall::Disc { center, radius } => {
+            finite_point(bad, &format!("{key}.center"), *center);
+            positive(bad, &format!("{key}.radius"), *radius);
+        }
+        Wall::Polygon { points } => {
+            let key = format!("{key}.points");
+            if points.len() < 3 {
+                bad(
+                    key,
+                    format!("a polygon needs at least 3 points, got {}", points.len()),
+                );
+                return;
+            }
+            if !points
+                .iter()
+                .enumerate()
+                .all(|(j, p)| finite_point(bad, &format!("{key}.{j}"), *p))
+            {
+                return;
+            }
+            let n = points.len();
+            let turns_left = (0..n).all(|j| {
+                let [a, b, c] = [points[j], points[(j + 1) % n], points[(j + 2) % n]];
+                (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) > 0.0
+            });
+            if !turns_left {
+                bad(
+                    key,
+                    "must be convex with its points in counter-clockwise order and no three in a line".into(),
+                );
+            } else if wall_shape(wall).is_none() {
+                bad(
+                    key,
+                    "parry cannot build a convex polygon from these points".into(),
+                );
+            }
+        }
+    }
+}
+
+fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, agent: &Agent) {
+    let key = |k: &str| format!("agents.{i}.{k}");
+    if agent.name.is_empty()
+        || !agent
+            .name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+    {
+        bad(
+            key("name"),
+            format!(
+                "`{}` must be non-empty and use only letters, digits, `-` and `_` (it becomes an entity path)",
+                agent.name
+            ),
+        );
+    }
+    if let Some(j) = world.agents[..i].iter().position(|a| a.name == agent.name) {
+        bad(
+            key("name"),
+            format!("`{}` is already the name of agents.{j}", agent.name),
+        );
+    }
+    positive(bad, &key("radius"), agent.radius);
+    positive(bad, &key("mass"), agent.mass);
+    let c = &agent.controller;
+    positive(bad, &key("controller.k"), c.k);
+    if !(c.b.is_finite() && c.b >= 0.0) {
+        bad(
+            key("controller.b"),
+            format!("must be a finite number ≥ 0, got {}", c.b),
+        );
+    }
+    if !(c.capture_radius.is_finite() && c.capture_radius >= 0.0) {
+        bad(
+            key("controller.capture_radius"),
+            format!("must be a finite number ≥ 0, got {}", c.capture_radius),
+        );
+    }
+    let start_ok = finite_point(bad, &key("start"), agent.start);
+    let target_ok = finite_point(bad, &key("target"), agent.target);
+    if !(agent.radius.is_finite() && agent.radius > 0.0) {
+        return;
+    }
+    let size = world.size;
+    for (what, p, ok) in [
+        ("start", agent.start, start_ok),
+        ("target", agent.target, target_ok),
+    ] {
+        if !ok {
+            continue;
+        }
+        let r = agent.radius;
+        if p[0] < r || p[1] < r || p[0] > size[0] - r || p[1] > size[1] - r {
+            bad(
+                key(what),
+                format!(
+                    "[{}, {}] puts the disc (radius {r} m) outside the box [0, {}] × [0, {}]",
+                    p[0], p[1], size[0], size[1]
+                ),
+            );
+            continue;
+        }
+        if let Some(wall) = blocking_wall(world, p, r) {
+            bad(
+                key(what),
+                format!(
+                    "[{}, {}] is inside or touching {wall} (the disc has radius {r} m)",
+                    p[0], p[1]
+                ),
+            );
+        }
+    }
+    if start_ok {
+        for (j, other) in world.agents[..i].iter().enumerate() {
+            let d = (agent.start[0] - other.start[0]).hypot(agent.start[1] - other.start[1]);
+            if d < agent.radius + other.radius {
+                bad(
+                    key("start"),
+                    format!(
+                        "overlaps the start of agents.{j} (`{}`): centres {d:.3} m apart",
+                        other.name
+                    ),
+                );
+            }
+        }
+    }
+}
+
+/// The first wall (described for a message) that a disc of radius `r` at `p` overlaps.
+fn blocking_wall(world: &World, p: [f64; 2], r: f64) -> Option<String> {
+    let outer = if world.walls_around {
+        outer_walls(world.size)
+    } else {
+        Vec::new()
+    };
+    let named = outer
+        .iter()
+        .map(|w| (w, "the outer wall".to_string()))
+        .chain(
+            world
+                .walls
+                .iter()
+                .enumerate()
+                .map(|(i, w)| (w, format!("walls.{i}"))),
+        );
+    for (wall, name) in named {
+        if let Some(shape) = wall_shape(wall) {
+            if shape.distance_to_point(p[0], p[1]) < r {
+                return Some(name);
+            }
+        }
+    }
+    None
+}
