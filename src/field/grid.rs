@@ -1,5 +1,9 @@
 //! The regular grid the field lives on: cell `(i, j)` has its centre at
-//! `((i + ½)·h, (j + ½)·h)`, so the grid covers the box `[0, W] × [0, H]` from its corner.
+//! `origin + ((i + ½)·h, (j + ½)·h)`, and the grid covers the box `[0, W] × [0, H]`.
+//!
+//! A field's grid is anchored so that the target is exactly a cell centre: the potential's
+//! minimum (the target cell) is then where the target is, and a body settles on the target
+//! rather than up to half a cell diagonal (3.5 cm at 5 cm cells) beside it.
 
 /// A regular grid over the world's box.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -10,6 +14,8 @@ pub struct Grid {
     pub ny: usize,
     /// Cell size h, m.
     pub cell: f64,
+    /// Corner of cell (0, 0), m: `[0, 0]`, or up to one cell below and left of it.
+    pub origin: [f64; 2],
 }
 
 impl Grid {
@@ -19,6 +25,20 @@ impl Grid {
             nx: ((size[0] / cell).ceil() as usize).max(1),
             ny: ((size[1] / cell).ceil() as usize).max(1),
             cell,
+            origin: [0.0, 0.0],
+        }
+    }
+
+    /// The grid of `cell`-sized cells that covers a box of `size` metres and has a cell centred
+    /// exactly on `anchor` (a point inside the box).
+    pub fn anchored(size: [f64; 2], cell: f64, anchor: [f64; 2]) -> Self {
+        let origin = anchor.map(|a| a - ((a / cell).floor() + 0.5) * cell);
+        let origin = origin.map(|o| if o > 0.0 { o - cell } else { o });
+        Self {
+            nx: (((size[0] - origin[0]) / cell).ceil() as usize).max(1),
+            ny: (((size[1] - origin[1]) / cell).ceil() as usize).max(1),
+            cell,
+            origin,
         }
     }
 
@@ -39,12 +59,18 @@ impl Grid {
 
     /// Centre of cell `(i, j)`, m.
     pub fn center(&self, i: usize, j: usize) -> [f64; 2] {
-        [(i as f64 + 0.5) * self.cell, (j as f64 + 0.5) * self.cell]
+        [
+            self.origin[0] + (i as f64 + 0.5) * self.cell,
+            self.origin[1] + (j as f64 + 0.5) * self.cell,
+        ]
     }
 
     /// The cell containing point `p`, if it is on the grid.
     pub fn cell_of(&self, p: [f64; 2]) -> Option<(usize, usize)> {
-        let (fx, fy) = (p[0] / self.cell, p[1] / self.cell);
+        let (fx, fy) = (
+            (p[0] - self.origin[0]) / self.cell,
+            (p[1] - self.origin[1]) / self.cell,
+        );
         if !(fx >= 0.0 && fy >= 0.0) {
             return None;
         }
@@ -59,12 +85,15 @@ impl Grid {
         lo: [f64; 2],
         hi: [f64; 2],
     ) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
-        let range = |lo: f64, hi: f64, n: usize| {
-            let a = (lo / self.cell - 0.5).floor().max(0.0) as usize;
-            let b = ((hi / self.cell - 0.5).ceil() + 1.0).clamp(0.0, n as f64) as usize;
+        let range = |lo: f64, hi: f64, o: f64, n: usize| {
+            let a = ((lo - o) / self.cell - 0.5).floor().max(0.0) as usize;
+            let b = (((hi - o) / self.cell - 0.5).ceil() + 1.0).clamp(0.0, n as f64) as usize;
             a.min(n)..b
         };
-        (range(lo[0], hi[0], self.nx), range(lo[1], hi[1], self.ny))
+        (
+            range(lo[0], hi[0], self.origin[0], self.nx),
+            range(lo[1], hi[1], self.origin[1], self.ny),
+        )
     }
 }
 
@@ -80,6 +109,18 @@ mod tests {
         assert_eq!(g.cell_of([0.95, 0.51]), Some((9, 5)));
         assert_eq!(g.cell_of([-0.01, 0.2]), None);
         assert_eq!(g.cell_of([1.05, 0.2]), None);
+    }
+
+    #[test]
+    fn anchored_grids_centre_a_cell_on_the_anchor_and_cover_the_box() {
+        for anchor in [[1.5, 8.5], [0.0, 0.0], [0.05, 9.99], [3.333, 2.0]] {
+            let g = Grid::anchored([10.0, 10.0], 0.05, anchor);
+            let (i, j) = g.cell_of(anchor).unwrap();
+            let c = g.center(i, j);
+            assert!((c[0] - anchor[0]).abs() < 1e-12 && (c[1] - anchor[1]).abs() < 1e-12);
+            assert!(g.origin.iter().all(|o| *o <= 0.0 && *o > -0.05));
+            assert!(g.cell_of([9.999, 9.999]).is_some() && g.cell_of([0.0, 0.0]).is_some());
+        }
     }
 
     #[test]

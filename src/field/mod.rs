@@ -78,7 +78,7 @@ impl HarmonicField {
     /// Rasterizes the world for `agent` and solves its field.
     pub fn solve(world: &World, agent: &Agent) -> Result<Self, FieldError> {
         let started = Instant::now();
-        let grid = Grid::covering(world.size, world.field.cell);
+        let grid = Grid::anchored(world.size, world.field.cell, agent.target);
         let walls = all_wall_shapes(world);
         let blocked = mask::rasterize(&grid, world.size, &walls, agent.radius);
         let target_cell = grid

@@ -49,8 +49,8 @@ impl Sampler {
     /// over the reachable ones; empty when none of the four is reachable.
     fn stencil(&self, p: [f64; 2]) -> Vec<(usize, f64)> {
         let g = &self.grid;
-        let fx = p[0] / g.cell - 0.5;
-        let fy = p[1] / g.cell - 0.5;
+        let fx = (p[0] - g.origin[0]) / g.cell - 0.5;
+        let fy = (p[1] - g.origin[1]) / g.cell - 0.5;
         if !(fx.is_finite() && fy.is_finite()) {
             return Vec::new();
         }

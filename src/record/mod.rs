@@ -124,11 +124,10 @@ impl Recorder {
             let (image, resolution) = colormap::potential_image(field);
             rec.log_static(
                 format!("agents/{name}/field/potential"),
-                &rerun::Transform3D::from_scale(rerun::Scale3D::from([
-                    grid.cell as f32,
-                    grid.cell as f32,
-                    1.0,
-                ])),
+                &rerun::Transform3D::from_translation_scale(
+                    [grid.origin[0] as f32, grid.origin[1] as f32, 0.0],
+                    rerun::Scale3D::from([grid.cell as f32, grid.cell as f32, 1.0]),
+                ),
             )?;
             rec.log_static(
                 format!("agents/{name}/field/potential"),

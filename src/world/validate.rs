@@ -29,8 +29,8 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
         && world.field.cell.is_finite()
         && world.field.cell > 0.0
     {
-        let cells =
-            (world.size[0] / world.field.cell).ceil() * (world.size[1] / world.field.cell).ceil();
+        let cells = ((world.size[0] / world.field.cell).ceil() + 1.0)
+            * ((world.size[1] / world.field.cell).ceil() + 1.0);
         if cells > MAX_CELLS as f64 {
             bad(
                 "field.cell".into(),

@@ -1,0 +1,238 @@
+//! The `nadf` binary end to end: recordings that decode, `--no-record`, `--json`, `check`.
+
+mod common;
+
+use std::collections::BTreeSet;
+use std::io::BufReader;
+use std::path::Path;
+use std::process::Command;
+
+use common::{nadf_bin, world_path};
+
+/// Every entity path and timeline in a recording, read back with Rerun's own decoder.
+fn decode(path: &Path) -> (BTreeSet<String>, BTreeSet<String>) {
+    let file = BufReader::new(std::fs::File::open(path).unwrap());
+    let messages = re_log_encoding::DecoderApp::decode_eager(file).unwrap();
+    let (mut entities, mut timelines) = (BTreeSet::new(), BTreeSet::new());
+    for msg in messages {
+        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
+            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
+            entities.insert(
+                chunk
+                    .entity_path()
+                    .to_string()
+                    .trim_start_matches('/')
+                    .to_string(),
+            );
+            timelines.extend(chunk.timelines().keys().map(|t| t.as_str().to_string()));
+        }
+    }
+    (entities, timelines)
+}
+
+#[test]
+fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let rrd = dir.path().join("room.rrd");
+    let json = dir.path().join("summary.json");
+    let out = Command::new(nadf_bin())
+        .arg("run")
+        .arg(world_path("room-two-dividers.toml"))
+        .arg("-o")
+        .arg(&rrd)
+        .arg("--json")
+        .arg(&json)
+        .args(["--set", "duration=8"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("robot") && stdout.contains("reached"),
+        "{stdout}"
+    );
+
+    let (entities, timelines) = decode(&rrd);
+    for e in [
+        "world/box",
+        "world/walls",
+        "agents/robot/field/potential",
+        "agents/robot/field/guidance",
+        "agents/robot/kinematic_path",
+        "agents/robot/target",
+        "agents/robot/body",
+        "agents/robot/trail",
+        "agents/robot/velocity",
+        "agents/robot/force",
+        "agents/robot/contacts",
+        "plots/robot/distance",
+        "plots/robot/speed",
+        "plots/robot/radial_speed",
+        "plots/robot/force",
+        "plots/robot/force_x",
+        "plots/robot/force_y",
+        "plots/robot/potential",
+    ] {
+        assert!(entities.contains(e), "no `{e}` in {entities:?}");
+    }
+    assert!(timelines.contains("sim_time"), "{timelines:?}");
+    // Only the finished files are left: no `.partial`.
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["room.rrd", "summary.json"]);
+
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(summary["world"], "room-two-dividers");
+    let agent = summary["agents"][0].as_object().unwrap();
+    let keys: BTreeSet<&str> = agent.keys().map(String::as_str).collect();
+    let expected: BTreeSet<&str> = [
+        "name",
+        "reached",
+        "settling_time",
+        "final_error",
+        "contacts",
+        "min_clearance",
+        "max_deviation",
+        "path_length",
+        "peak_force",
+        "control_variation",
+        "peak_speed",
+    ]
+    .into();
+    assert_eq!(keys, expected);
+    assert_eq!(agent["name"], "robot");
+    assert_eq!(agent["contacts"], 0);
+}
+
+#[test]
+fn no_record_writes_nothing_and_the_default_recording_is_named_after_the_world() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |extra: &[&str]| {
+        Command::new(nadf_bin())
+            .current_dir(dir.path())
+            .arg("run")
+            .arg(world_path("room-two-dividers.toml"))
+            .args(["--set", "duration=1"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&["--no-record"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+
+    let out = run(&[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rrd = dir.path().join("room-two-dividers.rrd");
+    assert!(rrd.is_file());
+    assert!(decode(&rrd).0.contains("agents/robot/body"));
+}
+
+#[test]
+fn check_accepts_every_shipped_world() {
+    let worlds: Vec<_> = std::fs::read_dir(world_path(""))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    assert!(worlds.len() >= 3);
+    let out = Command::new(nadf_bin())
+        .arg("check")
+        .args(&worlds)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn check_names_the_file_line_and_key_of_every_problem_and_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let broken = dir.path().join("broken.toml");
+    std::fs::write(
+        &broken,
+        "size = [4.0, 4.0]\n\n[[agents]]\nname = \"r\"\nstart = [1.0, 1.0]\ntarget = [3.0, 3.0]\nmasss = 1.0\n\n[agents.controller]\nkind = \"nadf\"\nb = 1.0\n",
+    )
+    .unwrap();
+    let out = Command::new(nadf_bin())
+        .arg("check")
+        .arg(&broken)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("broken.toml:7:1"), "{stderr}");
+    assert!(stderr.contains("masss"), "{stderr}");
+
+    // Semantic problems: all of them, each at its line.
+    std::fs::write(
+        &broken,
+        "size = [4.0, 4.0]\n\n[[agents]]\nname = \"r\"\nstart = [1.0, 1.0]\ntarget = [3.0, 3.0]\nmass = -1.0\nradius = 0.0\n\n[agents.controller]\nkind = \"nadf\"\nb = 1.0\n",
+    )
+    .unwrap();
+    let out = Command::new(nadf_bin())
+        .arg("check")
+        .arg(&broken)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("broken.toml:7:1: `agents.0.mass`"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("broken.toml:8:1: `agents.0.radius`"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_bad_override_is_named_and_fails_before_running() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(nadf_bin())
+        .current_dir(dir.path())
+        .arg("run")
+        .arg(world_path("room-two-dividers.toml"))
+        .args(["--set", "agents.3.controller.b=1"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("--set agents.3.controller.b=1"), "{stderr}");
+    assert!(stderr.contains("no item 3"), "{stderr}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+
+    let out = Command::new(nadf_bin())
+        .current_dir(dir.path())
+        .arg("run")
+        .arg(world_path("room-two-dividers.toml"))
+        .args(["--set", "agents.0.controller.b=-3"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--set agents.0.controller.b=-3"),
+        "{stderr}"
+    );
+}

@@ -1,0 +1,33 @@
+//! Helpers shared by the integration tests.
+
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use nadf::metrics::Summary;
+use nadf::run::{RunOptions, run};
+use nadf::world::{Override, World, load};
+
+/// A file under `worlds/`.
+pub fn world_path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("worlds")
+        .join(name)
+}
+
+/// Loads a world from `worlds/` with `--set`-style overrides.
+pub fn world(name: &str, overrides: &[&str]) -> World {
+    let overrides: Vec<Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
+    load(&world_path(name), &overrides).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Runs a world without recording and returns its first agent's summary.
+pub fn summary(name: &str, overrides: &[&str]) -> Summary {
+    let report = run(&world(name, overrides), &RunOptions::default()).unwrap();
+    report.agents.into_iter().next().unwrap()
+}
+
+/// The path of the built `nadf` binary.
+pub fn nadf_bin() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_nadf"))
+}

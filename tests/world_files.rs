@@ -1,0 +1,158 @@
+//! Loading world files: defaults, overrides, and errors that point at the line and key.
+
+use std::path::Path;
+
+use nadf::world::{ControllerKind, GuidanceKind, Override, Wall, load_str};
+
+const MINIMAL: &str = r#"size = [4.0, 3.0]
+
+[[agents]]
+name = "r"
+start = [1.0, 1.0]
+target = [3.0, 2.0]
+
+[agents.controller]
+kind = "nadf"
+b = 5.0
+"#;
+
+fn errors(text: &str, overrides: &[&str]) -> String {
+    let overrides: Vec<Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
+    load_str(text, Path::new("w.toml"), &overrides)
+        .unwrap_err()
+        .to_string()
+}
+
+#[test]
+fn defaults_fill_in_what_the_file_leaves_out() {
+    let w = load_str(MINIMAL, Path::new("dir/minimal.toml"), &[]).unwrap();
+    assert_eq!(w.name(), "minimal");
+    assert!(w.walls_around);
+    assert_eq!((w.dt, w.duration, w.seed), (0.01, 60.0, 0));
+    assert_eq!(w.field.cell, 0.05);
+    assert_eq!(w.field.guidance, GuidanceKind::Normalized);
+    let a = &w.agents[0];
+    assert_eq!((a.radius, a.mass, a.controller.k), (0.2, 1.0, 1.0));
+    assert_eq!(a.controller.kind, ControllerKind::Nadf);
+}
+
+#[test]
+fn overrides_set_values_index_arrays_and_create_tables() {
+    let sets: Vec<Override> = [
+        "agents.0.controller.kind=viscous",
+        "agents.0.controller.b=0.7",
+        "field.guidance=gradient",
+        "agents.0.target.1=2.5",
+        "name=renamed",
+    ]
+    .iter()
+    .map(|s| s.parse().unwrap())
+    .collect();
+    let w = load_str(MINIMAL, Path::new("w.toml"), &sets).unwrap();
+    assert_eq!(w.agents[0].controller.kind, ControllerKind::Viscous);
+    assert_eq!(w.agents[0].controller.b, 0.7);
+    assert_eq!(w.field.guidance, GuidanceKind::Gradient);
+    assert_eq!(w.agents[0].target, [3.0, 2.5]);
+    assert_eq!(w.name(), "renamed");
+}
+
+#[test]
+fn syntax_errors_name_the_line() {
+    let e = errors("size = [4.0, 3.0\n", &[]);
+    assert!(e.starts_with("error: w.toml:1:"), "{e}");
+    assert!(e.contains("syntax"), "{e}");
+}
+
+#[test]
+fn unknown_keys_and_wrong_types_name_the_line_and_key() {
+    let text = MINIMAL.replace("b = 5.0", "b = \"high\"");
+    let e = errors(&text, &[]);
+    assert!(e.contains("w.toml:10:5: `agents.0.controller.b`"), "{e}");
+
+    let text = MINIMAL.replace("[agents.controller]", "colour = 1\n[agents.controller]");
+    let e = errors(&text, &[]);
+    assert!(e.contains("w.toml:8:1: `agents.0.colour`"), "{e}");
+    assert!(e.contains("unknown field"), "{e}");
+}
+
+#[test]
+fn missing_required_keys_are_named() {
+    let text = MINIMAL.replace("target = [3.0, 2.0]\n", "");
+    let e = errors(&text, &[]);
+    assert!(e.contains("missing field `target`"), "{e}");
+}
+
+#[test]
+fn every_semantic_problem_is_reported_at_its_line() {
+    let text = r#"size = [4.0, 3.0]
+dt = 0.0
+
+[field]
+cell = -0.05
+
+[[walls]]
+shape = "polygon"
+points = [[0.0, 0.0], [1.0, 1.0], [1.0, 0.0]]
+
+[[agents]]
+name = "r"
+start = [0.1, 1.0]
+target = [3.0, nan]
+mass = 0.0
+
+[agents.controller]
+kind = "nadf"
+b = 5.0
+"#;
+    let e = errors(text, &[]);
+    for expected in [
+        "w.toml:2:1: `dt`",
+        "w.toml:5:1: `field.cell`",
+        "w.toml:9:1: `walls.0.points`: must be convex",
+        "w.toml:13:1: `agents.0.start`",
+        "w.toml:14:1: `agents.0.target`",
+        "w.toml:15:1: `agents.0.mass`",
+    ] {
+        assert!(e.contains(expected), "no `{expected}` in\n{e}");
+    }
+}
+
+#[test]
+fn starts_inside_walls_and_overlapping_agents_are_rejected() {
+    let text = format!(
+        "{MINIMAL}\n[[walls]]\nshape = \"disc\"\ncenter = [3.0, 2.0]\nradius = 0.3\n\n[[agents]]\nname = \"s\"\nstart = [1.2, 1.0]\ntarget = [1.0, 2.0]\n[agents.controller]\nkind = \"viscous\"\nb = 1.0\n"
+    );
+    let e = errors(&text, &[]);
+    assert!(
+        e.contains("`agents.0.target`") && e.contains("walls.0"),
+        "{e}"
+    );
+    assert!(
+        e.contains("`agents.1.start`") && e.contains("overlaps the start of agents.0"),
+        "{e}"
+    );
+}
+
+#[test]
+fn shapes_parse_with_their_own_keys() {
+    let text = format!(
+        "{MINIMAL}\n[[walls]]\nshape = \"segment\"\na = [2.0, 0.5]\nb = [2.0, 1.5]\nthickness = 0.1\n"
+    );
+    let w = load_str(&text, Path::new("w.toml"), &[]).unwrap();
+    assert!(matches!(w.walls[0], Wall::Segment { thickness, .. } if thickness == 0.1));
+    let e = errors(&text.replace("thickness", "radius"), &[]);
+    assert!(e.contains("unknown field `radius`"), "{e}");
+}
+
+#[test]
+fn an_override_that_breaks_the_world_is_named() {
+    let e = errors(MINIMAL, &["agents.0.mass=0"]);
+    assert!(e.contains("--set agents.0.mass=0"), "{e}");
+    let e = errors(MINIMAL, &["agents.0.speed=3"]);
+    assert!(
+        e.contains("--set agents.0.speed=3") && e.contains("unknown field"),
+        "{e}"
+    );
+    let e = errors(MINIMAL, &["size.x=3"]);
+    assert!(e.contains("index it with a number"), "{e}");
+}
