@@ -58,15 +58,47 @@ pub struct Report {
     /// The recording written, if any.
     #[serde(skip)]
     pub recording: Option<PathBuf>,
+    /// How each agent's field was solved.
+    #[serde(skip)]
+    pub fields: Vec<FieldStats>,
+}
+
+/// How one agent's field was solved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldStats {
+    /// The agent.
+    pub agent: String,
+    /// Grid cells along x and y.
+    pub cells: [usize; 2],
+    /// Solver sweeps.
+    pub iterations: usize,
+    /// The largest relative per-cell change in the last sweep.
+    pub relative_change: f64,
+    /// Whether the solver stopped at its round-off floor.
+    pub stalled: bool,
+    /// Wall-clock time of the solve.
+    pub solve_time: Duration,
 }
 
 /// Simulates `world` to its duration.
 pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
     let started = Instant::now();
     let mut sim = Simulation::new(world)?;
+    let fields = sim
+        .agents
+        .iter()
+        .map(|a| FieldStats {
+            agent: a.agent.name.clone(),
+            cells: [a.field.grid().nx, a.field.grid().ny],
+            iterations: a.field.iterations,
+            relative_change: a.field.relative_change,
+            stalled: a.field.stalled,
+            solve_time: a.field.solve_time,
+        })
+        .collect();
     let mut recorder = match &options.recording {
         Some(path) => {
-            let mut r = Recorder::create(path, world.name())?;
+            let mut r = Recorder::create(path, world)?;
             if let Err(e) = r.log_setup(&sim) {
                 r.abandon();
                 return Err(e.into());
@@ -87,11 +119,11 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
     });
     while !sim.finished() {
         let states = sim.step();
-        if let Some(r) = &mut recorder {
-            if let Err(e) = r.log_step(&sim, &states) {
-                recorder.take().expect("present").abandon();
-                return Err(e.into());
-            }
+        if let Some(r) = &mut recorder
+            && let Err(e) = r.log_step(&sim, &states)
+        {
+            recorder.take().expect("present").abandon();
+            return Err(e.into());
         }
         if let Some(bar) = &bar {
             bar.inc(1);
@@ -106,6 +138,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         agents: sim.summaries(),
         wall_time: started.elapsed(),
         recording,
+        fields,
     };
     if let Some(path) = &options.json {
         write_atomically(path, report.to_json().as_bytes()).map_err(|source| RunError::Json {
@@ -136,9 +169,22 @@ impl Report {
         serde_json::to_string_pretty(self).expect("summaries are plain data") + "\n"
     }
 
-    /// The summary as a plain-text table, one row per agent.
+    /// The summary as a plain-text table, one row per agent, after one line per field solve.
     pub fn table(&self) -> String {
-        let mut out = format!(
+        let mut out = String::new();
+        for f in &self.fields {
+            out += &format!(
+                "field of {}: {} x {} cells, {} sweeps, largest relative change {:.1e}{}, {:.0} ms\n",
+                f.agent,
+                f.cells[0],
+                f.cells[1],
+                f.iterations,
+                f.relative_change,
+                if f.stalled { " (round-off floor)" } else { "" },
+                f.solve_time.as_secs_f64() * 1e3
+            );
+        }
+        out += &format!(
             "{:<12} {:>7} {:>9} {:>9} {:>8} {:>9} {:>9} {:>8} {:>8} {:>9} {:>8}\n",
             "agent",
             "reached",

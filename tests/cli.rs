@@ -236,3 +236,58 @@ fn a_bad_override_is_named_and_fails_before_running() {
         "{stderr}"
     );
 }
+
+#[test]
+fn an_intractable_task_is_bad_input_naming_the_agent() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = dir.path().join("enclosed.toml");
+    // The start is inside a closed square of walls.
+    std::fs::write(
+        &world,
+        r#"size = [6.0, 6.0]
+
+[[walls]]
+shape = "box"
+center = [2.0, 1.0]
+half_extents = [1.0, 0.05]
+
+[[walls]]
+shape = "box"
+center = [2.0, 3.0]
+half_extents = [1.0, 0.05]
+
+[[walls]]
+shape = "box"
+center = [1.0, 2.0]
+half_extents = [0.05, 1.0]
+
+[[walls]]
+shape = "box"
+center = [3.0, 2.0]
+half_extents = [0.05, 1.0]
+
+[[agents]]
+name = "boxed-in"
+start = [2.0, 2.0]
+target = [5.0, 5.0]
+
+[agents.controller]
+kind = "nadf"
+b = 10.0
+"#,
+    )
+    .unwrap();
+    let out = Command::new(nadf_bin())
+        .current_dir(dir.path())
+        .args(["run", "enclosed.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("`boxed-in`") && stderr.contains("cannot be reached"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("enclosed.rrd").exists());
+    assert!(!dir.path().join("enclosed.rrd.partial").exists());
+}

@@ -70,6 +70,9 @@ pub struct HarmonicField {
     pub iterations: usize,
     /// The largest relative per-cell change in the last sweep.
     pub relative_change: f64,
+    /// Whether the solver stopped at its round-off floor (see [`laplace`]) rather than at
+    /// `field.tolerance`.
+    pub stalled: bool,
     /// Wall-clock time of the solve.
     pub solve_time: Duration,
 }
@@ -105,6 +108,7 @@ impl HarmonicField {
             target: agent.target,
             iterations: solution.iterations,
             relative_change: solution.relative_change,
+            stalled: solution.stalled,
             solve_time: started.elapsed(),
         };
         if field.sampler.grad_w(agent.start).is_none() {

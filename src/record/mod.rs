@@ -16,6 +16,7 @@
 //! The recording is written to `OUT.rrd.partial` and renamed to `OUT.rrd` once complete, so an
 //! existing recording is never replaced by a broken one.
 
+mod blueprint;
 mod colormap;
 
 use std::path::{Path, PathBuf};
@@ -23,7 +24,7 @@ use std::path::{Path, PathBuf};
 use rerun::{RecordingStream, RecordingStreamBuilder};
 
 use crate::sim::{AgentState, Simulation};
-use crate::world::{Wall, all_walls};
+use crate::world::{Wall, World, all_walls};
 
 /// Steps between two updates of the trail (which is re-logged whole).
 const TRAIL_EVERY: usize = 10;
@@ -73,13 +74,14 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// Starts a recording that will end up at `path`.
-    pub fn create(path: &Path, recording_name: &str) -> Result<Self, RecordError> {
+    /// Starts the recording of `world` that will end up at `path`.
+    pub fn create(path: &Path, world: &World) -> Result<Self, RecordError> {
         let mut partial = path.as_os_str().to_owned();
         partial.push(".partial");
         let partial = PathBuf::from(partial);
         let stream = RecordingStreamBuilder::new("nadf")
-            .recording_name(recording_name)
+            .recording_name(world.name())
+            .with_blueprint(blueprint::layout(world))
             .save(&partial)
             .map_err(|source| RecordError::Stream {
                 path: partial.clone(),

@@ -18,10 +18,14 @@ pub fn to_rapier(v: Vector2<f64>) -> Vector {
 
 /// A Rapier world with no gravity and the given step.
 pub fn empty_world(dt: f64) -> PhysicsWorld {
-    let mut physics = PhysicsWorld::default();
-    physics.gravity = Vector::ZERO;
-    physics.integration_parameters.dt = dt as f32;
-    physics
+    PhysicsWorld {
+        gravity: Vector::ZERO,
+        integration_parameters: IntegrationParameters {
+            dt: dt as f32,
+            ..IntegrationParameters::default()
+        },
+        ..PhysicsWorld::default()
+    }
 }
 
 /// Inserts the walls as colliders of one fixed body and returns their handles, in order.

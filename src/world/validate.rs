@@ -261,10 +261,10 @@ fn blocking_wall(world: &World, p: [f64; 2], r: f64) -> Option<String> {
                 .map(|(i, w)| (w, format!("walls.{i}"))),
         );
     for (wall, name) in named {
-        if let Some(shape) = wall_shape(wall) {
-            if shape.distance_to_point(p[0], p[1]) < r {
-                return Some(name);
-            }
+        if let Some(shape) = wall_shape(wall)
+            && shape.distance_to_point(p[0], p[1]) < r
+        {
+            return Some(name);
         }
     }
     None

@@ -1,0 +1,45 @@
+//! The viewer layout stored in every recording: the world on the left, the time series on the
+//! right, grouped by quantity. Without it the viewer would guess a view per plot and a view
+//! rooted at the field image.
+
+use rerun::blueprint::{Blueprint, Horizontal, Spatial2DView, TimeSeriesView, Vertical};
+
+use crate::world::World;
+
+/// The layout for `world`. Every agent's field image is logged, but only the first agent's is
+/// shown (they overlap); the others can be switched on in the viewer.
+pub fn layout(world: &World) -> Blueprint {
+    let mut spatial = vec!["+ /world/**".to_string(), "+ /agents/**".to_string()];
+    for agent in world.agents.iter().skip(1) {
+        spatial.push(format!("- /agents/{}/field/**", agent.name));
+    }
+    let series = |title: &str, names: &[&str]| {
+        let contents: Vec<String> = world
+            .agents
+            .iter()
+            .flat_map(|a| {
+                names
+                    .iter()
+                    .map(move |n| format!("+ /plots/{}/{n}", a.name))
+            })
+            .collect();
+        TimeSeriesView::new(title).with_contents(contents)
+    };
+    Blueprint::new(
+        Horizontal::new([
+            Spatial2DView::new(world.name())
+                .with_origin("/")
+                .with_contents(spatial)
+                .into(),
+            Vertical::new([
+                series("distance to target (m)", &["distance"]).into(),
+                series("speed (m/s)", &["speed", "radial_speed"]).into(),
+                series("control force (N)", &["force", "force_x", "force_y"]).into(),
+                series("potential V", &["potential"]).into(),
+            ])
+            .into(),
+        ])
+        .with_column_shares([3.0, 2.0]),
+    )
+    .with_auto_views(false)
+}
