@@ -1,8 +1,10 @@
 //! The viewer layout stored in every recording: the world on the left, the time series on the
-//! right, grouped by quantity. Without it the viewer would guess a view per plot and a view
-//! rooted at the field image.
+//! right, grouped by quantity, on the `sim_time` timeline, opening at the end of the run (the
+//! whole trail in view; scrub or press play to replay it). Without it the viewer would guess a
+//! view per plot and a view rooted at the field image.
 
-use rerun::blueprint::{Blueprint, Horizontal, Spatial2DView, TimeSeriesView, Vertical};
+use rerun::blueprint::components::PlayState;
+use rerun::blueprint::{Blueprint, Horizontal, Spatial2DView, TimePanel, TimeSeriesView, Vertical};
 
 use crate::world::World;
 
@@ -42,4 +44,9 @@ pub fn layout(world: &World) -> Blueprint {
         .with_column_shares([3.0, 2.0]),
     )
     .with_auto_views(false)
+    .with_time_panel(
+        TimePanel::new()
+            .with_timeline("sim_time")
+            .with_play_state(PlayState::Following),
+    )
 }
