@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use nadf::field::FreeSpace;
 use nadf::run::{RunError, RunOptions, run};
 use nadf::world::{Override, load};
 
@@ -124,18 +125,32 @@ fn run_command(
 fn check_command(paths: &[PathBuf]) -> ExitCode {
     let mut ok = true;
     for path in paths {
-        match load(path, &[]) {
-            Ok(world) => println!(
+        let world = match load(path, &[]) {
+            Ok(world) => world,
+            Err(errors) => {
+                ok = false;
+                eprintln!("{errors}");
+                continue;
+            }
+        };
+        // The file is well formed; is every agent's task tractable on its grid?
+        let problems: Vec<String> = world
+            .agents
+            .iter()
+            .filter_map(|agent| FreeSpace::of(&world, agent).err())
+            .map(|e| format!("error: {}: {e}", path.display()))
+            .collect();
+        if problems.is_empty() {
+            println!(
                 "{}: ok ({}, {} agent(s), {} wall(s))",
                 path.display(),
                 world.name(),
                 world.agents.len(),
                 world.walls.len()
-            ),
-            Err(errors) => {
-                ok = false;
-                eprintln!("{errors}");
-            }
+            );
+        } else {
+            ok = false;
+            eprintln!("{}", problems.join("\n"));
         }
     }
     if ok {

@@ -181,7 +181,10 @@ fn check_names_the_file_line_and_key_of_every_problem_and_fails() {
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("broken.toml:7:1"), "{stderr}");
-    assert!(stderr.contains("masss"), "{stderr}");
+    assert!(
+        stderr.contains("masss") && stderr.contains("did you mean `mass`?"),
+        "{stderr}"
+    );
 
     // Semantic problems: all of them, each at its line.
     std::fs::write(
@@ -290,4 +293,17 @@ b = 10.0
     );
     assert!(!dir.path().join("enclosed.rrd").exists());
     assert!(!dir.path().join("enclosed.rrd.partial").exists());
+
+    // `check` finds it without running.
+    let out = Command::new(nadf_bin())
+        .current_dir(dir.path())
+        .args(["check", "enclosed.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("enclosed.toml: agent `boxed-in`"),
+        "{stderr}"
+    );
 }

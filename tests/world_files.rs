@@ -73,6 +73,11 @@ fn unknown_keys_and_wrong_types_name_the_line_and_key() {
     let e = errors(&text, &[]);
     assert!(e.contains("w.toml:8:1: `agents.0.colour`"), "{e}");
     assert!(e.contains("unknown field"), "{e}");
+
+    let text = MINIMAL.replace("kind = \"nadf\"", "kind = \"nadv\"");
+    let e = errors(&text, &[]);
+    assert!(e.contains("w.toml:9:8: `agents.0.controller.kind`"), "{e}");
+    assert!(e.contains("did you mean `nadf`?"), "{e}");
 }
 
 #[test]

@@ -77,10 +77,23 @@ pub struct HarmonicField {
     pub solve_time: Duration,
 }
 
-impl HarmonicField {
-    /// Rasterizes the world for `agent` and solves its field.
-    pub fn solve(world: &World, agent: &Agent) -> Result<Self, FieldError> {
-        let started = Instant::now();
+/// One agent's configuration space on its grid: where its centre may be, and which of those
+/// cells connect to the target. Cheap (no solve), so `nadf check` builds it too.
+#[derive(Debug, Clone)]
+pub struct FreeSpace {
+    /// The grid, anchored on the target.
+    pub grid: Grid,
+    /// `true` where the agent's centre cannot be.
+    pub blocked: Vec<bool>,
+    /// The target's cell.
+    pub target_cell: (usize, usize),
+    /// `true` for the free cells connected to the target cell.
+    pub reachable: Vec<bool>,
+}
+
+impl FreeSpace {
+    /// Rasterizes the world for `agent` and checks that its start connects to its target.
+    pub fn of(world: &World, agent: &Agent) -> Result<Self, FieldError> {
         let grid = Grid::anchored(world.size, world.field.cell, agent.target);
         let walls = all_wall_shapes(world);
         let blocked = mask::rasterize(&grid, world.size, &walls, agent.radius);
@@ -91,10 +104,36 @@ impl HarmonicField {
                 agent: agent.name.clone(),
                 cell: grid.cell,
             })?;
-        let solution = laplace::solve_sor(
-            &grid,
-            &blocked,
+        let reachable = laplace::reachable_from(&grid, &blocked, target_cell);
+        // The start is connected when a cell around it is: the cells the sampler interpolates.
+        let near = |c: usize, n: usize| c.saturating_sub(1)..=(c + 1).min(n - 1);
+        let start_connected = grid.cell_of(agent.start).is_some_and(|(i, j)| {
+            near(i, grid.nx).any(|a| near(j, grid.ny).any(|b| reachable[grid.index(a, b)]))
+        });
+        if !start_connected {
+            return Err(FieldError::Unreachable {
+                agent: agent.name.clone(),
+                radius: agent.radius,
+            });
+        }
+        Ok(Self {
+            grid,
+            blocked,
             target_cell,
+            reachable,
+        })
+    }
+}
+
+impl HarmonicField {
+    /// Rasterizes the world for `agent` and solves its field.
+    pub fn solve(world: &World, agent: &Agent) -> Result<Self, FieldError> {
+        let started = Instant::now();
+        let space = FreeSpace::of(world, agent)?;
+        let solution = laplace::solve_sor(
+            &space.grid,
+            &space.reachable,
+            space.target_cell,
             world.field.tolerance,
             MAX_SWEEPS,
         )
@@ -102,22 +141,15 @@ impl HarmonicField {
             agent: agent.name.clone(),
             source,
         })?;
-        let field = Self {
-            sampler: Sampler::new(grid, solution.w, solution.reachable),
-            blocked,
+        Ok(Self {
+            sampler: Sampler::new(space.grid, solution.w, solution.reachable),
+            blocked: space.blocked,
             target: agent.target,
             iterations: solution.iterations,
             relative_change: solution.relative_change,
             stalled: solution.stalled,
             solve_time: started.elapsed(),
-        };
-        if field.sampler.grad_w(agent.start).is_none() {
-            return Err(FieldError::Unreachable {
-                agent: agent.name.clone(),
-                radius: agent.radius,
-            });
-        }
-        Ok(field)
+        })
     }
 
     /// The grid.

@@ -131,6 +131,12 @@ impl Simulation {
             let distance = (x - Vector2::from(run.agent.target)).norm();
             let g = run.field.gradient(x.into());
             let force = run.controller.force(distance, &v, g.as_ref());
+            // Finite in f64 but beyond f32's range is still not finite for Rapier.
+            let force = if to_rapier(force).is_finite() {
+                force
+            } else {
+                Vector2::zeros()
+            };
             body.reset_forces(false);
             body.add_force(to_rapier(force), true);
             run.metrics.record_force(force);

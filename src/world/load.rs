@@ -15,6 +15,7 @@ use toml_edit::{DocumentMut, Item, TableLike, Value};
 
 use super::error::{WorldError, WorldErrors, line_column};
 use super::schema::World;
+use super::suggest::with_suggestion;
 use super::validate::validate;
 
 /// One `--set KEY=VALUE` override: a dotted path (array items by index) and a TOML value.
@@ -150,7 +151,7 @@ fn parse(text: &str, file: &Path) -> Result<World, Vec<Problem>> {
         vec![Problem {
             span,
             key,
-            message: e.message().trim().to_string(),
+            message: with_suggestion(e.message().trim()),
         }]
     })?;
     if world.name.is_none() {

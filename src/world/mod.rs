@@ -7,6 +7,7 @@ mod error;
 mod load;
 mod schema;
 mod shapes;
+mod suggest;
 mod validate;
 
 pub use error::{WorldError, WorldErrors};
