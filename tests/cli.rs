@@ -9,6 +9,30 @@ use std::process::Command;
 
 use common::{nadf_bin, world_path};
 
+/// Runs `nadf ARGS` in `dir`.
+fn nadf(dir: &Path, args: &[&str]) -> std::process::Output {
+    Command::new(nadf_bin())
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Runs `nadf run worlds/room-two-dividers.toml ARGS` in `dir`.
+fn run_room(dir: &Path, args: &[&str]) -> std::process::Output {
+    let world = world_path("room-two-dividers.toml");
+    let mut all = vec!["run", world.to_str().unwrap()];
+    all.extend_from_slice(args);
+    nadf(dir, &all)
+}
+
+/// A file under `tests/fixtures/`.
+fn fixture(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(name)
+}
+
 /// Every entity path and timeline in a recording, read back with Rerun's own decoder.
 fn decode(path: &Path) -> (BTreeSet<String>, BTreeSet<String>) {
     let file = BufReader::new(std::fs::File::open(path).unwrap());
@@ -35,16 +59,15 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
     let dir = tempfile::tempdir().unwrap();
     let rrd = dir.path().join("room.rrd");
     let json = dir.path().join("summary.json");
-    let out = Command::new(nadf_bin())
-        .arg("run")
-        .arg(world_path("room-two-dividers.toml"))
-        .arg("-o")
-        .arg(&rrd)
-        .arg("--json")
-        .arg(&json)
-        .args(["--set", "duration=8"])
-        .output()
-        .unwrap();
+    let args = [
+        "-o",
+        "room.rrd",
+        "--json",
+        "summary.json",
+        "--set",
+        "duration=8",
+    ];
+    let out = run_room(dir.path(), &args);
     assert!(
         out.status.success(),
         "{}",
@@ -115,17 +138,7 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
 #[test]
 fn no_record_writes_nothing_and_the_default_recording_is_named_after_the_world() {
     let dir = tempfile::tempdir().unwrap();
-    let run = |extra: &[&str]| {
-        Command::new(nadf_bin())
-            .current_dir(dir.path())
-            .arg("run")
-            .arg(world_path("room-two-dividers.toml"))
-            .args(["--set", "duration=1"])
-            .args(extra)
-            .output()
-            .unwrap()
-    };
-    let out = run(&["--no-record"]);
+    let out = run_room(dir.path(), &["--set", "duration=1", "--no-record"]);
     assert!(
         out.status.success(),
         "{}",
@@ -133,7 +146,7 @@ fn no_record_writes_nothing_and_the_default_recording_is_named_after_the_world()
     );
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 
-    let out = run(&[]);
+    let out = run_room(dir.path(), &["--set", "duration=1"]);
     assert!(
         out.status.success(),
         "{}",
@@ -173,11 +186,7 @@ fn check_names_the_file_line_and_key_of_every_problem_and_fails() {
         "size = [4.0, 4.0]\n\n[[agents]]\nname = \"r\"\nstart = [1.0, 1.0]\ntarget = [3.0, 3.0]\nmasss = 1.0\n\n[agents.controller]\nkind = \"nadf\"\nb = 1.0\n",
     )
     .unwrap();
-    let out = Command::new(nadf_bin())
-        .arg("check")
-        .arg(&broken)
-        .output()
-        .unwrap();
+    let out = nadf(dir.path(), &["check", "broken.toml"]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("broken.toml:7:1"), "{stderr}");
@@ -192,11 +201,7 @@ fn check_names_the_file_line_and_key_of_every_problem_and_fails() {
         "size = [4.0, 4.0]\n\n[[agents]]\nname = \"r\"\nstart = [1.0, 1.0]\ntarget = [3.0, 3.0]\nmass = -1.0\nradius = 0.0\n\n[agents.controller]\nkind = \"nadf\"\nb = 1.0\n",
     )
     .unwrap();
-    let out = Command::new(nadf_bin())
-        .arg("check")
-        .arg(&broken)
-        .output()
-        .unwrap();
+    let out = nadf(dir.path(), &["check", "broken.toml"]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -212,26 +217,14 @@ fn check_names_the_file_line_and_key_of_every_problem_and_fails() {
 #[test]
 fn a_bad_override_is_named_and_fails_before_running() {
     let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(nadf_bin())
-        .current_dir(dir.path())
-        .arg("run")
-        .arg(world_path("room-two-dividers.toml"))
-        .args(["--set", "agents.3.controller.b=1"])
-        .output()
-        .unwrap();
+    let out = run_room(dir.path(), &["--set", "agents.3.controller.b=1"]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("--set agents.3.controller.b=1"), "{stderr}");
     assert!(stderr.contains("no item 3"), "{stderr}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 
-    let out = Command::new(nadf_bin())
-        .current_dir(dir.path())
-        .arg("run")
-        .arg(world_path("room-two-dividers.toml"))
-        .args(["--set", "agents.0.controller.b=-3"])
-        .output()
-        .unwrap();
+    let out = run_room(dir.path(), &["--set", "agents.0.controller.b=-3"]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -243,48 +236,8 @@ fn a_bad_override_is_named_and_fails_before_running() {
 #[test]
 fn an_intractable_task_is_bad_input_naming_the_agent() {
     let dir = tempfile::tempdir().unwrap();
-    let world = dir.path().join("enclosed.toml");
-    // The start is inside a closed square of walls.
-    std::fs::write(
-        &world,
-        r#"size = [6.0, 6.0]
-
-[[walls]]
-shape = "box"
-center = [2.0, 1.0]
-half_extents = [1.0, 0.05]
-
-[[walls]]
-shape = "box"
-center = [2.0, 3.0]
-half_extents = [1.0, 0.05]
-
-[[walls]]
-shape = "box"
-center = [1.0, 2.0]
-half_extents = [0.05, 1.0]
-
-[[walls]]
-shape = "box"
-center = [3.0, 2.0]
-half_extents = [0.05, 1.0]
-
-[[agents]]
-name = "boxed-in"
-start = [2.0, 2.0]
-target = [5.0, 5.0]
-
-[agents.controller]
-kind = "nadf"
-b = 10.0
-"#,
-    )
-    .unwrap();
-    let out = Command::new(nadf_bin())
-        .current_dir(dir.path())
-        .args(["run", "enclosed.toml"])
-        .output()
-        .unwrap();
+    std::fs::copy(fixture("enclosed.toml"), dir.path().join("enclosed.toml")).unwrap();
+    let out = nadf(dir.path(), &["run", "enclosed.toml"]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -295,11 +248,7 @@ b = 10.0
     assert!(!dir.path().join("enclosed.rrd.partial").exists());
 
     // `check` finds it without running.
-    let out = Command::new(nadf_bin())
-        .current_dir(dir.path())
-        .args(["check", "enclosed.toml"])
-        .output()
-        .unwrap();
+    let out = nadf(dir.path(), &["check", "enclosed.toml"]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(

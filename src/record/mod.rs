@@ -202,24 +202,20 @@ impl Recorder {
                     .with_radii([run.agent.radius as f32])
                     .with_colors([colour]),
             )?;
-            rec.log(
-                format!("agents/{name}/velocity"),
-                &rerun::Arrows2D::from_vectors([[
-                    state.velocity.x as f32 * VELOCITY_SCALE,
-                    state.velocity.y as f32 * VELOCITY_SCALE,
-                ]])
-                .with_origins([p])
-                .with_colors([rerun::Color::from_rgb(80, 200, 255)]),
-            )?;
-            rec.log(
-                format!("agents/{name}/force"),
-                &rerun::Arrows2D::from_vectors([[
-                    state.force.x as f32 * FORCE_SCALE,
-                    state.force.y as f32 * FORCE_SCALE,
-                ]])
-                .with_origins([p])
-                .with_colors([rerun::Color::from_rgb(255, 90, 200)]),
-            )?;
+            for (what, vector, scale, colour) in [
+                ("velocity", state.velocity, VELOCITY_SCALE, [80, 200, 255]),
+                ("force", state.force, FORCE_SCALE, [255, 90, 200]),
+            ] {
+                rec.log(
+                    format!("agents/{name}/{what}"),
+                    &rerun::Arrows2D::from_vectors([[
+                        vector.x as f32 * scale,
+                        vector.y as f32 * scale,
+                    ]])
+                    .with_origins([p])
+                    .with_colors([rerun::Color::from_rgb(colour[0], colour[1], colour[2])]),
+                )?;
+            }
             let contacts: Vec<[f32; 2]> = state
                 .contact_points
                 .iter()
