@@ -10,11 +10,12 @@
 //!   kinematic streamline.
 //! - [`control`]: guidance and the damping laws (viscous, NADF) behind one trait.
 //! - [`sim`]: the Rapier world and the step loop.
-//! - [`metrics`]: what a run reports per agent.
+//! - [`metrics`]: what a run reports per agent; [`expect`]: checking it against `[expect]`.
 //! - [`record`]: the Rerun recording.
 //! - [`run`](mod@run): a whole headless run, as the `nadf run` command does it.
 
 pub mod control;
+pub mod expect;
 pub mod field;
 pub mod metrics;
 pub mod record;

@@ -3,6 +3,8 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
 
@@ -12,8 +14,11 @@ use nadf::world::{Override, load};
 
 /// Exit status for bad input (a world file, an override or an intractable task).
 const BAD_INPUT: u8 = 2;
-/// Exit status for a run that could not complete (e.g. an output could not be written).
+/// Exit status for a run that finished but missed an `[expect]`ation, or could not write an
+/// output.
 const FAILED: u8 = 1;
+/// Exit status for a run stopped by Ctrl-C (128 + SIGINT).
+const INTERRUPTED: u8 = 130;
 
 #[derive(Parser)]
 #[command(
@@ -89,10 +94,17 @@ fn run_command(
             PathBuf::from(stem).with_extension("rrd")
         })
     });
+    // Ctrl-C stops the run after the current step; the recording is closed properly.
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&interrupt);
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        eprintln!("warning: Ctrl-C will not stop the run cleanly: {e}");
+    }
     let options = RunOptions {
         recording,
         json,
         progress: std::io::stderr().is_terminal() && std::env::var_os("CI").is_none(),
+        interrupt: Some(interrupt),
     };
     match run(&world, &options) {
         Ok(report) => {
@@ -109,7 +121,27 @@ fn run_command(
                     report.wall_time.as_secs_f64()
                 ),
             }
-            ExitCode::SUCCESS
+            if let Some(t) = report.interrupted_at {
+                eprintln!(
+                    "interrupted at t = {t:.2} s of {} s: the summary and the recording cover the run so far",
+                    world.duration
+                );
+                return ExitCode::from(INTERRUPTED);
+            }
+            let failures = nadf::expect::failures(&world, &report.agents);
+            if failures.is_empty() {
+                ExitCode::SUCCESS
+            } else {
+                eprintln!(
+                    "{}: {} expectation(s) failed:",
+                    path.display(),
+                    failures.len()
+                );
+                for f in &failures {
+                    eprintln!("  {f}");
+                }
+                ExitCode::from(FAILED)
+            }
         }
         Err(e @ RunError::Field(_)) => {
             eprintln!("error: {}: {e}", path.display());

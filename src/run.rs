@@ -2,6 +2,8 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
@@ -21,6 +23,10 @@ pub struct RunOptions {
     pub json: Option<PathBuf>,
     /// Show a progress bar on standard error.
     pub progress: bool,
+    /// Set (e.g. by a Ctrl-C handler) to stop the run after the current step. The recording is
+    /// then closed properly, so it holds the run up to that moment; the JSON summary is not
+    /// written (it would look like a finished run's).
+    pub interrupt: Option<Arc<AtomicBool>>,
 }
 
 /// Why a run failed.
@@ -61,6 +67,9 @@ pub struct Report {
     /// How each agent's field was solved.
     #[serde(skip)]
     pub fields: Vec<FieldStats>,
+    /// The simulated time at which the run was interrupted, if it was.
+    #[serde(skip)]
+    pub interrupted_at: Option<f64>,
 }
 
 /// How one agent's field was solved.
@@ -117,7 +126,18 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         bar.set_message(format!("simulating {}", world.name()));
         bar
     });
+    let interrupted = || {
+        options
+            .interrupt
+            .as_ref()
+            .is_some_and(|i| i.load(Ordering::Relaxed))
+    };
+    let mut interrupted_at = None;
     while !sim.finished() {
+        if interrupted() {
+            interrupted_at = Some(sim.time());
+            break;
+        }
         let states = sim.step();
         if let Some(r) = &mut recorder
             && let Err(e) = r.log_step(&sim, &states)
@@ -139,8 +159,9 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         wall_time: started.elapsed(),
         recording,
         fields,
+        interrupted_at,
     };
-    if let Some(path) = &options.json {
+    if let Some(path) = options.json.as_ref().filter(|_| interrupted_at.is_none()) {
         write_atomically(path, report.to_json().as_bytes()).map_err(|source| RunError::Json {
             path: path.clone(),
             source,

@@ -138,7 +138,7 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
 #[test]
 fn no_record_writes_nothing_and_the_default_recording_is_named_after_the_world() {
     let dir = tempfile::tempdir().unwrap();
-    let out = run_room(dir.path(), &["--set", "duration=1", "--no-record"]);
+    let out = run_room(dir.path(), &["--set", "duration=8", "--no-record"]);
     assert!(
         out.status.success(),
         "{}",
@@ -146,7 +146,7 @@ fn no_record_writes_nothing_and_the_default_recording_is_named_after_the_world()
     );
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 
-    let out = run_room(dir.path(), &["--set", "duration=1"]);
+    let out = run_room(dir.path(), &["--set", "duration=8"]);
     assert!(
         out.status.success(),
         "{}",

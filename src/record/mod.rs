@@ -28,6 +28,9 @@ use crate::world::{Wall, World, all_walls};
 
 /// Steps between two updates of the trail (which is re-logged whole).
 const TRAIL_EVERY: usize = 10;
+/// Wall-clock time between two flushes of the file, so that a run killed outright still leaves
+/// a `.partial` file that decodes up to its last few seconds.
+const FLUSH_EVERY: std::time::Duration = std::time::Duration::from_secs(1);
 /// Arrows shown per side of the box in the guidance arrow field.
 const GUIDANCE_ARROWS: usize = 24;
 /// Length of a velocity arrow per m/s, m.
@@ -71,6 +74,7 @@ pub struct Recorder {
     path: PathBuf,
     trails: Vec<Vec<[f32; 2]>>,
     steps: usize,
+    last_flush: std::time::Instant,
 }
 
 impl Recorder {
@@ -93,6 +97,7 @@ impl Recorder {
             path: path.to_path_buf(),
             trails: Vec::new(),
             steps: 0,
+            last_flush: std::time::Instant::now(),
         })
     }
 
@@ -250,6 +255,11 @@ impl Recorder {
                     &rerun::Scalars::single(value),
                 )?;
             }
+        }
+        if self.last_flush.elapsed() >= FLUSH_EVERY {
+            // A failed flush is not fatal here: the next one, or the footer, retries.
+            let _ = self.stream.flush_blocking();
+            self.last_flush = std::time::Instant::now();
         }
         Ok(())
     }

@@ -13,8 +13,8 @@ mod validate;
 pub use error::{WorldError, WorldErrors};
 pub use load::{Override, load, load_str};
 pub use schema::{
-    Agent, ControllerKind, ControllerSettings, FieldSettings, GuidanceKind, OUTER_WALL_THICKNESS,
-    Wall, World,
+    Agent, ControllerKind, ControllerSettings, Expect, FieldSettings, GuidanceKind,
+    OUTER_WALL_THICKNESS, Wall, World,
 };
 pub use shapes::{WallShape, all_wall_shapes, all_walls, outer_walls, wall_shape};
 pub use validate::{MAX_CELLS, validate};

@@ -35,6 +35,37 @@ pub struct World {
     /// The controlled bodies (at least one).
     #[serde(default)]
     pub agents: Vec<Agent>,
+    /// What every agent's run must show (`nadf run` exits 1 when it does not).
+    #[serde(default)]
+    pub expect: Option<Expect>,
+}
+
+/// An `[expect]` table: assertions on a run's summary, for users' own collision tests. Every
+/// key is optional; `nadf run` checks the ones given and exits with status 1, listing what
+/// failed, when any does not hold.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Expect {
+    /// Whether the agent must end within the settling band (`true`) or outside it (`false`).
+    pub reached: Option<bool>,
+    /// The exact number of contact starts (`contacts = 0`: never touch anything).
+    pub contacts: Option<usize>,
+    /// At least this many contact starts (for worlds that show a crash).
+    pub min_contacts: Option<usize>,
+    /// At most this many contact starts.
+    pub max_contacts: Option<usize>,
+    /// The agent must settle, and no later than this, s.
+    pub max_settling_time: Option<f64>,
+    /// The smallest clearance to the walls must be at least this, m.
+    pub min_clearance: Option<f64>,
+    /// The final distance to the target must be at most this, m.
+    pub max_final_error: Option<f64>,
+    /// `δ_m` must be at most this, m.
+    pub max_deviation: Option<f64>,
+    /// The peak speed must be at most this, m/s.
+    pub max_peak_speed: Option<f64>,
+    /// The peak control force must be at most this, N.
+    pub max_peak_force: Option<f64>,
 }
 
 /// Thickness of the walls that `walls_around = true` adds, m.
@@ -131,6 +162,9 @@ pub struct Agent {
     pub mass: f64,
     /// The control law.
     pub controller: ControllerSettings,
+    /// What this agent's run must show, on top of the world's `[expect]`.
+    #[serde(default)]
+    pub expect: Option<Expect>,
 }
 
 /// The `[agents.controller]` table.

@@ -2,7 +2,7 @@
 //! agents that start in free space. Each problem is a dotted key path and a message; the loader
 //! turns the path into a line of the file.
 
-use super::schema::{Agent, Wall, World};
+use super::schema::{Agent, Expect, Wall, World};
 use super::shapes::{outer_walls, wall_shape};
 
 /// The largest grid the field solver accepts, in cells (4096 × 4096). A world whose `size` and
@@ -55,6 +55,15 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
         check_wall(&mut bad, &format!("walls.{i}"), wall);
     }
 
+    if let Some(expect) = &world.expect {
+        check_expect(&mut bad, "expect", expect);
+    }
+    for (i, agent) in world.agents.iter().enumerate() {
+        if let Some(expect) = &agent.expect {
+            check_expect(&mut bad, &format!("agents.{i}.expect"), expect);
+        }
+    }
+
     if world.agents.is_empty() {
         bad(
             "agents".into(),
@@ -72,6 +81,34 @@ fn positive(bad: &mut impl FnMut(String, String), key: &str, x: f64) {
         bad(
             key.into(),
             format!("must be a positive finite number, got {x}"),
+        );
+    }
+}
+
+fn check_expect(bad: &mut impl FnMut(String, String), key: &str, e: &Expect) {
+    for (name, value) in [
+        ("max_settling_time", e.max_settling_time),
+        ("min_clearance", e.min_clearance),
+        ("max_final_error", e.max_final_error),
+        ("max_deviation", e.max_deviation),
+        ("max_peak_speed", e.max_peak_speed),
+        ("max_peak_force", e.max_peak_force),
+    ] {
+        if let Some(x) = value
+            && !(x.is_finite() && x >= 0.0)
+        {
+            bad(
+                format!("{key}.{name}"),
+                format!("must be a finite number ≥ 0, got {x}"),
+            );
+        }
+    }
+    if let (Some(lo), Some(hi)) = (e.min_contacts, e.max_contacts)
+        && lo > hi
+    {
+        bad(
+            format!("{key}.min_contacts"),
+            format!("{lo} is more than max_contacts = {hi}"),
         );
     }
 }

@@ -1,0 +1,142 @@
+//! Checking a run against the world's `[expect]` tables: how a user writes a collision test
+//! without Rust. `nadf run` exits with status 1 and lists what failed.
+
+use crate::metrics::Summary;
+use crate::world::{Expect, World};
+
+/// Every expectation of `world` that a run with these summaries (in agent order) misses, as
+/// readable lines (`robot: contacts = 2, expected 0`). Empty when all hold.
+pub fn failures(world: &World, summaries: &[Summary]) -> Vec<String> {
+    let mut out = Vec::new();
+    for (agent, summary) in world.agents.iter().zip(summaries) {
+        for expect in [&world.expect, &agent.expect].into_iter().flatten() {
+            out.extend(
+                check(expect, summary)
+                    .into_iter()
+                    .map(|m| format!("{}: {m}", summary.name)),
+            );
+        }
+    }
+    out
+}
+
+/// The expectations in `e` that `s` misses.
+pub fn check(e: &Expect, s: &Summary) -> Vec<String> {
+    let mut failed = Vec::new();
+    if let Some(reached) = e.reached
+        && s.reached != reached
+    {
+        failed.push(format!("reached = {}, expected {reached}", s.reached));
+    }
+    if let Some(n) = e.contacts
+        && s.contacts != n
+    {
+        failed.push(format!("contacts = {}, expected {n}", s.contacts));
+    }
+    if let Some(n) = e.min_contacts
+        && s.contacts < n
+    {
+        failed.push(format!("contacts = {}, expected at least {n}", s.contacts));
+    }
+    if let Some(n) = e.max_contacts
+        && s.contacts > n
+    {
+        failed.push(format!("contacts = {}, expected at most {n}", s.contacts));
+    }
+    if let Some(limit) = e.max_settling_time {
+        match s.settling_time {
+            None => failed.push(format!("never settled, expected settling_time ≤ {limit} s")),
+            Some(t) if t > limit => {
+                failed.push(format!("settling_time = {t:.3} s, expected ≤ {limit} s"))
+            }
+            Some(_) => {}
+        }
+    }
+    let mut at_least = |name: &str, value: f64, bound: Option<f64>, unit: &str| {
+        if let Some(b) = bound
+            && value < b
+        {
+            failed.push(format!("{name} = {value:.4} {unit}, expected ≥ {b} {unit}"));
+        }
+    };
+    at_least("min_clearance", s.min_clearance, e.min_clearance, "m");
+    for (name, value, bound, unit) in [
+        ("final_error", s.final_error, e.max_final_error, "m"),
+        ("max_deviation", s.max_deviation, e.max_deviation, "m"),
+        ("peak_speed", s.peak_speed, e.max_peak_speed, "m/s"),
+        ("peak_force", s.peak_force, e.max_peak_force, "N"),
+    ] {
+        if let Some(b) = bound
+            && (value > b || value.is_nan())
+        {
+            failed.push(format!("{name} = {value:.4} {unit}, expected ≤ {b} {unit}"));
+        }
+    }
+    failed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn summary() -> Summary {
+        Summary {
+            name: "r".into(),
+            reached: true,
+            settling_time: Some(5.0),
+            final_error: 0.01,
+            contacts: 0,
+            min_clearance: 0.3,
+            max_deviation: 0.2,
+            path_length: 10.0,
+            peak_force: 30.0,
+            control_variation: 100.0,
+            peak_speed: 4.0,
+        }
+    }
+
+    #[test]
+    fn met_expectations_pass_and_missed_ones_are_listed() {
+        let ok = Expect {
+            reached: Some(true),
+            contacts: Some(0),
+            max_settling_time: Some(6.0),
+            min_clearance: Some(0.25),
+            max_final_error: Some(0.05),
+            max_deviation: Some(0.25),
+            max_peak_speed: Some(5.0),
+            max_peak_force: Some(40.0),
+            ..Expect::default()
+        };
+        assert!(check(&ok, &summary()).is_empty());
+
+        let strict = Expect {
+            min_contacts: Some(1),
+            max_settling_time: Some(4.0),
+            min_clearance: Some(0.5),
+            max_peak_speed: Some(3.0),
+            ..Expect::default()
+        };
+        let failed = check(&strict, &summary());
+        assert_eq!(failed.len(), 4, "{failed:?}");
+        assert!(failed[0].contains("expected at least 1"));
+        assert!(failed[1].contains("settling_time = 5.000 s, expected ≤ 4 s"));
+    }
+
+    #[test]
+    fn an_agent_that_never_settles_misses_a_settling_time() {
+        let s = Summary {
+            settling_time: None,
+            reached: false,
+            ..summary()
+        };
+        let e = Expect {
+            max_settling_time: Some(60.0),
+            ..Expect::default()
+        };
+        assert_eq!(
+            check(&e, &s),
+            ["never settled, expected settling_time ≤ 60 s"]
+        );
+    }
+}

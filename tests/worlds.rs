@@ -1,0 +1,67 @@
+//! Every world shipped in `worlds/` carries the expectations it meets, and `nadf run` checks
+//! them; a missed expectation exits with status 1 and a readable list.
+
+mod common;
+
+use std::process::Command;
+
+use common::{nadf_bin, world_path};
+
+#[test]
+fn every_shipped_world_meets_its_expectations() {
+    let mut worlds: Vec<_> = std::fs::read_dir(world_path(""))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    worlds.sort();
+    assert!(worlds.len() >= 3);
+    for path in worlds {
+        let world = nadf::world::load(&path, &[]).unwrap();
+        let has_expectations =
+            world.expect.is_some() || world.agents.iter().any(|a| a.expect.is_some());
+        assert!(has_expectations, "{} has no [expect] table", path.display());
+        let out = Command::new(nadf_bin())
+            .arg("run")
+            .arg(&path)
+            .arg("--no-record")
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}: {}\n{}",
+            path.display(),
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
+#[test]
+fn a_missed_expectation_exits_1_and_says_what_failed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(nadf_bin())
+        .current_dir(dir.path())
+        .arg("run")
+        .arg(world_path("room-two-dividers.toml"))
+        .args([
+            "--no-record",
+            "--set",
+            "expect.max_settling_time=3",
+            "--set",
+            "expect.contacts=2",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("2 expectation(s) failed"), "{stderr}");
+    assert!(
+        stderr.contains("robot: contacts = 0, expected 2"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("robot: settling_time = 4.840 s, expected ≤ 3 s"),
+        "{stderr}"
+    );
+}
