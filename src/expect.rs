@@ -92,6 +92,7 @@ mod tests {
             peak_force: 30.0,
             control_variation: 100.0,
             peak_speed: 4.0,
+            faults: crate::metrics::Faults::default(),
         }
     }
 

@@ -41,6 +41,33 @@ pub struct Summary {
     pub control_variation: f64,
     /// Largest speed, m/s.
     pub peak_speed: f64,
+    /// Numerical faults met during the run (all zero in a healthy run).
+    pub faults: Faults,
+}
+
+/// Numerical faults of one agent's run (see `sim::faults`).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct Faults {
+    /// Steps in which the guidance was undefined: the gradient vanished or reversed from one
+    /// step to the next (the body is on a critical point, e.g. a saddle), the field was flat, or
+    /// the body was off the field. Not counted within two cells of the target.
+    pub guidance_lost_steps: usize,
+    /// Steps whose control force could not be given to Rapier (not finite in f32); zero was
+    /// applied instead.
+    pub rejected_forces: usize,
+    /// Times the body was pushed more than 1 cm into a wall.
+    pub penetrations: usize,
+    /// Steps with the body's centre outside the box.
+    pub left_box_steps: usize,
+    /// Whether Rapier's state of the body became non-finite (the body was then frozen).
+    pub non_finite_state: bool,
+}
+
+impl Faults {
+    /// Whether nothing went wrong.
+    pub fn is_clean(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 /// Accumulates one agent's metrics over a run.
@@ -133,7 +160,7 @@ impl Metrics {
     }
 
     /// The summary, with `δ_m` measured against `kinematic`.
-    pub fn summary(&self, kinematic: &Streamline) -> Summary {
+    pub fn summary(&self, kinematic: &Streamline, faults: &Faults) -> Summary {
         let reached = self.final_distance <= self.band;
         let max_deviation = self
             .path
@@ -156,6 +183,7 @@ impl Metrics {
             peak_force: self.peak_force,
             control_variation: self.control_variation,
             peak_speed: self.peak_speed,
+            faults: faults.clone(),
         }
     }
 }
@@ -178,7 +206,7 @@ mod tests {
         for (t, x) in [(1.0, 5.0), (2.0, 9.7), (3.0, 10.6), (4.0, 9.9), (5.0, 10.0)] {
             m.record_state(t, Vector2::new(x, 0.0), v, 1.0);
         }
-        let s = m.summary(&straight());
+        let s = m.summary(&straight(), &Faults::default());
         assert!(s.reached);
         assert_eq!(s.settling_time, Some(4.0));
         assert_eq!(s.final_error, 0.0);
@@ -190,7 +218,7 @@ mod tests {
         let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0]);
         m.record_state(1.0, Vector2::new(9.9, 0.0), Vector2::zeros(), 1.0);
         m.record_state(2.0, Vector2::new(8.0, 1.0), Vector2::new(3.0, 4.0), 0.2);
-        let s = m.summary(&straight());
+        let s = m.summary(&straight(), &Faults::default());
         assert!(!s.reached);
         assert_eq!(s.settling_time, None);
         assert_eq!(s.max_deviation, 1.0);
@@ -204,7 +232,7 @@ mod tests {
         for f in [[1.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 2.0]] {
             m.record_force(Vector2::from(f));
         }
-        let s = m.summary(&straight());
+        let s = m.summary(&straight(), &Faults::default());
         assert_eq!(s.control_variation, 3.0);
         assert_eq!(s.peak_force, 2.0);
     }

@@ -238,6 +238,22 @@ impl Report {
                 s.peak_speed
             );
         }
+        for s in self.agents.iter().filter(|s| !s.faults.is_clean()) {
+            let f = &s.faults;
+            out += &format!(
+                "faults of {}: {} steps without guidance, {} rejected forces, {} penetrations, {} steps outside the box{}\n",
+                s.name,
+                f.guidance_lost_steps,
+                f.rejected_forces,
+                f.penetrations,
+                f.left_box_steps,
+                if f.non_finite_state {
+                    ", non-finite state (frozen)"
+                } else {
+                    ""
+                }
+            );
+        }
         out
     }
 }

@@ -128,6 +128,7 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
         "peak_force",
         "control_variation",
         "peak_speed",
+        "faults",
     ]
     .into();
     assert_eq!(keys, expected);

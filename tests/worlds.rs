@@ -21,10 +21,14 @@ fn every_shipped_world_meets_its_expectations() {
         let has_expectations =
             world.expect.is_some() || world.agents.iter().any(|a| a.expect.is_some());
         assert!(has_expectations, "{} has no [expect] table", path.display());
+        let dir = tempfile::tempdir().unwrap();
+        let json = dir.path().join("s.json");
         let out = Command::new(nadf_bin())
             .arg("run")
             .arg(&path)
             .arg("--no-record")
+            .arg("--json")
+            .arg(&json)
             .output()
             .unwrap();
         assert!(
@@ -34,6 +38,21 @@ fn every_shipped_world_meets_its_expectations() {
             String::from_utf8_lossy(&out.stdout),
             String::from_utf8_lossy(&out.stderr)
         );
+        // And no numerical fault along the way.
+        let text = std::fs::read_to_string(&json).unwrap();
+        let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+        for agent in summary["agents"].as_array().unwrap() {
+            let faults = &agent["faults"];
+            for key in [
+                "guidance_lost_steps",
+                "rejected_forces",
+                "penetrations",
+                "left_box_steps",
+            ] {
+                assert_eq!(faults[key], 0, "{}: {faults}", path.display());
+            }
+            assert_eq!(faults["non_finite_state"], false);
+        }
     }
 }
 

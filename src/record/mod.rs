@@ -8,6 +8,7 @@
 //! - `agents/NAME/field/guidance`: a sparse arrow field of the unit guidance `-∇V/|∇V|` (static).
 //! - `agents/NAME/kinematic_path`, `agents/NAME/target` (static).
 //! - `agents/NAME/body`, `…/trail`, `…/velocity`, `…/force`, `…/contacts`: per step.
+//! - `agents/NAME/events`: numerical faults as they start (text log, level WARN).
 //! - `plots/NAME/{distance, speed, radial_speed, force, force_x, force_y, potential}`: scalars.
 //!
 //! Time is the `sim_time` timeline, in seconds. The world is y-up while Rerun's 2D views are
@@ -232,6 +233,12 @@ impl Recorder {
                     .with_radii([0.06])
                     .with_colors([rerun::Color::from_rgb(255, 0, 0)]),
             )?;
+            for event in &state.events {
+                rec.log(
+                    format!("agents/{name}/events"),
+                    &rerun::TextLog::new(event.as_str()).with_level(rerun::TextLogLevel::WARN),
+                )?;
+            }
             trail.push(p);
             if self.steps % TRAIL_EVERY == 1 || sim.finished() {
                 rec.log(

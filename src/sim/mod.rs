@@ -6,13 +6,13 @@
 //! the new one (Rapier's user forces persist across steps otherwise), then step Rapier once.
 //! Rapier's narrow phase then says which pairs touch.
 
+pub mod faults;
 mod physics;
 
 use std::collections::HashSet;
 
 use nalgebra::Vector2;
-use parry2d::math::Pose;
-use parry2d::shape::Ball;
+use parry2d::math::Vector;
 use rapier2d::prelude::{ColliderHandle, PhysicsWorld, RigidBodyHandle};
 
 pub use physics::{from_rapier, to_rapier};
@@ -21,6 +21,7 @@ use crate::control::{Controller, unit};
 use crate::field::{FieldError, HarmonicField, Streamline};
 use crate::metrics::{Metrics, Summary};
 use crate::world::{Agent, WallShape, World, all_wall_shapes};
+use faults::{FaultMonitor, Observation};
 
 /// A pair counts as touching when Rapier has an active contact between them whose distance is
 /// at most this, m. Rapier also keeps speculative contacts up to its prediction distance
@@ -39,9 +40,12 @@ pub struct AgentRun {
     pub controller: Controller<2>,
     /// Its metrics so far.
     pub metrics: Metrics,
+    /// Its numerical faults so far.
+    pub faults: FaultMonitor,
     body: RigidBodyHandle,
     collider: ColliderHandle,
     touching: HashSet<ColliderHandle>,
+    frozen: bool,
 }
 
 /// What happened to one agent in the last step, for recording.
@@ -64,6 +68,8 @@ pub struct AgentState {
     pub clearance: f64,
     /// Points where the agent touches something, m.
     pub contact_points: Vec<Vector2<f64>>,
+    /// Faults that started in this step, as messages.
+    pub events: Vec<String>,
 }
 
 /// A running simulation.
@@ -96,9 +102,11 @@ impl Simulation {
                 agent: agent.clone(),
                 field,
                 kinematic,
+                faults: FaultMonitor::default(),
                 body,
                 collider,
                 touching: HashSet::new(),
+                frozen: false,
             });
         }
         Ok(Self {
@@ -124,19 +132,26 @@ impl Simulation {
     /// Advances one physics step and returns each agent's state after it.
     pub fn step(&mut self) -> Vec<AgentState> {
         let mut forces = Vec::with_capacity(self.agents.len());
-        for run in &mut self.agents {
+        let mut events: Vec<Vec<String>> = vec![Vec::new(); self.agents.len()];
+        for (run, events) in self.agents.iter_mut().zip(&mut events) {
             let body = &mut self.physics.bodies[run.body];
             let x = from_rapier(body.translation());
             let v = from_rapier(body.linvel());
-            let distance = (x - Vector2::from(run.agent.target)).norm();
-            let g = run.field.gradient(x.into());
-            let force = run.controller.force(distance, &v, g.as_ref());
-            // Finite in f64 but beyond f32's range is still not finite for Rapier.
-            let force = if to_rapier(force).is_finite() {
-                force
-            } else {
-                Vector2::zeros()
-            };
+            let mut force = Vector2::zeros();
+            if !run.frozen && !(x.iter().chain(v.iter()).all(|c| c.is_finite())) {
+                run.frozen = true;
+                events.extend(run.faults.non_finite_state());
+            }
+            if !run.frozen {
+                let distance = (x - Vector2::from(run.agent.target)).norm();
+                let g = run.field.gradient(x.into());
+                force = run.controller.force(distance, &v, g.as_ref());
+                // Finite in f64 but beyond f32's range is still not finite for Rapier.
+                if !to_rapier(force).is_finite() {
+                    force = Vector2::zeros();
+                    events.extend(run.faults.rejected_force());
+                }
+            }
             body.reset_forces(false);
             body.add_force(to_rapier(force), true);
             run.metrics.record_force(force);
@@ -147,10 +162,23 @@ impl Simulation {
         self.time = self.steps as f64 * self.world.dt;
 
         let mut states = Vec::with_capacity(self.agents.len());
-        for (run, force) in self.agents.iter_mut().zip(forces) {
+        for ((run, force), mut events) in self.agents.iter_mut().zip(forces).zip(events) {
             let body = &self.physics.bodies[run.body];
-            let position = from_rapier(body.translation());
-            let velocity = from_rapier(body.linvel());
+            let (mut position, mut velocity) =
+                (from_rapier(body.translation()), from_rapier(body.linvel()));
+            if !position
+                .iter()
+                .chain(velocity.iter())
+                .all(|c| c.is_finite())
+            {
+                if !run.frozen {
+                    run.frozen = true;
+                    events.extend(run.faults.non_finite_state());
+                }
+                // Report the last finite state; nothing non-finite reaches the metrics.
+                position = Vector2::from(*run.metrics.path().last().expect("starts at the start"));
+                velocity = Vector2::zeros();
+            }
             let p: [f64; 2] = position.into();
             let distance = (position - Vector2::from(run.agent.target)).norm();
             let radial_speed = run
@@ -158,7 +186,14 @@ impl Simulation {
                 .gradient(p)
                 .and_then(|g| unit(&g))
                 .map_or(0.0, |u| -u.dot(&velocity));
-            let clearance = clearance(&self.walls, position, run.agent.radius);
+            let signed = signed_clearance(&self.walls, position, run.agent.radius);
+            let clearance = signed.max(0.0);
+            events.extend(run.faults.observe(&Observation {
+                field: &run.field,
+                position,
+                signed_clearance: signed,
+                size: self.world.size,
+            }));
 
             // Contact starts: pairs touching now that were not touching after the last step.
             let mut now = HashSet::new();
@@ -167,10 +202,10 @@ impl Simulation {
                 if !pair.has_any_active_contact() {
                     continue;
                 }
-                let other = if pair.collider1 == run.collider {
-                    pair.collider2
+                let (other, side) = if pair.collider1 == run.collider {
+                    (pair.collider2, 1.0)
                 } else {
-                    pair.collider1
+                    (pair.collider1, -1.0)
                 };
                 for manifold in pair.manifolds() {
                     if manifold
@@ -180,11 +215,6 @@ impl Simulation {
                     {
                         // The normal points from collider 1 to collider 2.
                         let n = from_rapier(manifold.data.normal);
-                        let side = if pair.collider1 == run.collider {
-                            1.0
-                        } else {
-                            -1.0
-                        };
                         contact_points.push(position + n * (side * run.agent.radius));
                         now.insert(other);
                     }
@@ -204,6 +234,7 @@ impl Simulation {
                 potential: run.field.potential(p),
                 clearance,
                 contact_points,
+                events,
             });
         }
         states
@@ -213,18 +244,22 @@ impl Simulation {
     pub fn summaries(&self) -> Vec<Summary> {
         self.agents
             .iter()
-            .map(|a| a.metrics.summary(&a.kinematic))
+            .map(|a| a.metrics.summary(&a.kinematic, &a.faults.faults))
             .collect()
     }
 }
 
-/// Distance from a disc of `radius` at `position` to the nearest wall, m (0 when overlapping).
-pub fn clearance(walls: &[WallShape], position: Vector2<f64>, radius: f64) -> f64 {
-    let disc = Ball::new(radius as f32);
-    let pose = Pose::from_translation(to_rapier(position));
+/// Signed distance from a disc of `radius` at `position` to the nearest wall, m: positive when
+/// clear, negative by the overlap depth when the disc is inside a wall.
+pub fn signed_clearance(walls: &[WallShape], position: Vector2<f64>, radius: f64) -> f64 {
+    let centre = Vector::new(position.x as f32, position.y as f32);
     walls
         .iter()
-        .filter_map(|w| parry2d::query::distance(&pose, &disc, &w.pose, w.shape.as_ref()).ok())
-        .map(|d| f64::from(d.distance))
+        .map(|w| {
+            let projection = w.shape.project_point(&w.pose, centre, false);
+            let d = f64::from((projection.point - centre).length());
+            if projection.is_inside { -d } else { d }
+        })
         .fold(f64::INFINITY, f64::min)
+        - radius
 }
