@@ -161,3 +161,31 @@ fn an_override_that_breaks_the_world_is_named() {
     let e = errors(MINIMAL, &["size.x=3"]);
     assert!(e.contains("index it with a number"), "{e}");
 }
+
+#[test]
+fn a_grid_over_the_limit_is_rejected_unless_the_limit_is_raised() {
+    let e = errors(MINIMAL, &["field.cell=0.0005"]);
+    assert!(e.contains("more than field.max_cells = 16777216"), "{e}");
+    assert!(e.contains("raise field.max_cells"), "{e}");
+    let sets: Vec<Override> = ["field.cell=0.0005", "field.max_cells=100000000"]
+        .iter()
+        .map(|s| s.parse().unwrap())
+        .collect();
+    assert!(load_str(MINIMAL, Path::new("w.toml"), &sets).is_ok());
+}
+
+#[test]
+fn non_finite_numbers_are_rejected_wherever_they_appear() {
+    for (key, value) in [
+        ("dt", "nan"),
+        ("duration", "inf"),
+        ("size.1", "-inf"),
+        ("agents.0.controller.k", "nan"),
+        ("agents.0.controller.b", "inf"),
+        ("agents.0.radius", "nan"),
+        ("field.tolerance", "nan"),
+    ] {
+        let e = errors(MINIMAL, &[&format!("{key}={value}")]);
+        assert!(e.contains(&format!("`{key}`")), "{key}: {e}");
+    }
+}

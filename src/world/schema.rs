@@ -84,6 +84,9 @@ pub struct FieldSettings {
     /// Relative per-cell tolerance at which the Laplace solver stops.
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
+    /// The largest grid accepted, in cells (about 40 bytes of memory each, per agent).
+    #[serde(default = "default_max_cells")]
+    pub max_cells: u64,
 }
 
 impl Default for FieldSettings {
@@ -92,6 +95,7 @@ impl Default for FieldSettings {
             cell: default_cell(),
             guidance: GuidanceKind::default(),
             tolerance: default_tolerance(),
+            max_cells: default_max_cells(),
         }
     }
 }
@@ -207,6 +211,9 @@ fn default_cell() -> f64 {
 }
 fn default_tolerance() -> f64 {
     1e-9
+}
+fn default_max_cells() -> u64 {
+    super::validate::MAX_CELLS
 }
 fn default_radius() -> f64 {
     0.2

@@ -5,8 +5,9 @@
 use super::schema::{Agent, Expect, Wall, World};
 use super::shapes::{outer_walls, wall_shape};
 
-/// The largest grid the field solver accepts, in cells (4096 × 4096). A world whose `size` and
-/// `field.cell` give more cells is rejected: raise `field.cell`, or change this limit and rebuild.
+/// The default of `field.max_cells`, the largest grid accepted (4096 × 4096 cells, about 640 MB
+/// per agent). A world whose `size` and `field.cell` give more cells is rejected unless it
+/// raises `field.max_cells`.
 pub const MAX_CELLS: u64 = 4096 * 4096;
 
 /// Every problem in a parsed world, as `(key path, message)`; empty when the world is valid.
@@ -31,11 +32,12 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
     {
         let cells = ((world.size[0] / world.field.cell).ceil() + 1.0)
             * ((world.size[1] / world.field.cell).ceil() + 1.0);
-        if cells > MAX_CELLS as f64 {
+        let limit = world.field.max_cells;
+        if cells > limit as f64 {
             bad(
                 "field.cell".into(),
                 format!(
-                    "a {} m cell over a {} × {} m box makes {cells:.0} grid cells, more than the limit of {MAX_CELLS} (4096²); use a larger cell",
+                    "a {} m cell over a {} × {} m box makes {cells:.0} grid cells, more than field.max_cells = {limit} (default {MAX_CELLS} = 4096²); use a larger cell, or raise field.max_cells (about 40 bytes per cell and agent)",
                     world.field.cell, world.size[0], world.size[1]
                 ),
             );
