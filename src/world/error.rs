@@ -34,6 +34,14 @@ impl fmt::Display for WorldError {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub struct WorldErrors(pub Vec<WorldError>);
 
+impl WorldErrors {
+    /// The errors in the order of the file: by line and column, unlocated ones last.
+    pub fn in_file_order(mut errors: Vec<WorldError>) -> Self {
+        errors.sort_by_key(|e| e.location.unwrap_or((usize::MAX, usize::MAX)));
+        Self(errors)
+    }
+}
+
 impl fmt::Display for WorldErrors {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         for (i, e) in self.0.iter().enumerate() {

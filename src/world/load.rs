@@ -79,7 +79,7 @@ pub fn load_str(text: &str, file: &Path, overrides: &[Override]) -> Result<World
         };
     // The file as written: every error here has a line.
     let world = parse(text, file).map_err(|problems| {
-        WorldErrors(
+        WorldErrors::in_file_order(
             problems
                 .into_iter()
                 .map(|p| error(p.span.map(|s| line_column(text, s.start)), p.key, p.message))
@@ -104,7 +104,7 @@ pub fn load_str(text: &str, file: &Path, overrides: &[Override]) -> Result<World
     let edited = doc.to_string();
     parse(&edited, file).map_err(|problems| {
         let original = Spans::of(text);
-        WorldErrors(
+        WorldErrors::in_file_order(
             problems
                 .into_iter()
                 .map(|p| {
