@@ -68,11 +68,7 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
         "duration=8",
     ];
     let out = run_room(dir.path(), &args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_success(&out);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains("robot") && stdout.contains("reached"),
@@ -140,19 +136,11 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
 fn no_record_writes_nothing_and_the_default_recording_is_named_after_the_world() {
     let dir = tempfile::tempdir().unwrap();
     let out = run_room(dir.path(), &["--set", "duration=8", "--no-record"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_success(&out);
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 
     let out = run_room(dir.path(), &["--set", "duration=8"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_success(&out);
     let rrd = dir.path().join("room-two-dividers.rrd");
     assert!(rrd.is_file());
     assert!(decode(&rrd).0.contains("agents/robot/body"));
@@ -171,11 +159,7 @@ fn check_accepts_every_shipped_world() {
         .args(&worlds)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_success(&out);
 }
 
 #[test]

@@ -17,11 +17,7 @@ fn summary_bytes(threads: &str) -> Vec<u8> {
         .args(["--no-record", "--json", "s.json", "--set", "duration=20"])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_success(&out);
     std::fs::read(dir.path().join("s.json")).unwrap()
 }
 

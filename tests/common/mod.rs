@@ -31,3 +31,12 @@ pub fn summary(name: &str, overrides: &[&str]) -> Summary {
 pub fn nadf_bin() -> PathBuf {
     PathBuf::from(env!("CARGO_BIN_EXE_nadf"))
 }
+
+/// Asserts that a run of the binary succeeded, showing its standard error if not.
+pub fn assert_success(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
