@@ -79,12 +79,12 @@ pub struct FieldStats {
     pub agent: String,
     /// Grid cells along x and y.
     pub cells: [usize; 2],
-    /// Solver sweeps.
+    /// Conjugate gradient iterations over all solves.
     pub iterations: usize,
-    /// The largest relative per-cell change in the last sweep.
-    pub relative_change: f64,
-    /// Whether the solver stopped at its round-off floor.
-    pub stalled: bool,
+    /// Solves (the first plus the nested ones for deep regions).
+    pub solves: usize,
+    /// The worst final relative residual.
+    pub relative_residual: f64,
     /// Wall-clock time of the solve.
     pub solve_time: Duration,
 }
@@ -100,8 +100,8 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
             agent: a.agent.name.clone(),
             cells: [a.field.grid().nx, a.field.grid().ny],
             iterations: a.field.iterations,
-            relative_change: a.field.relative_change,
-            stalled: a.field.stalled,
+            solves: a.field.solves,
+            relative_residual: a.field.relative_residual,
             solve_time: a.field.solve_time,
         })
         .collect();
@@ -195,13 +195,13 @@ impl Report {
         let mut out = String::new();
         for f in &self.fields {
             out += &format!(
-                "field of {}: {} x {} cells, {} sweeps, largest relative change {:.1e}{}, {:.0} ms\n",
+                "field of {}: {} x {} cells, {} solve(s), {} iterations, relative residual {:.1e}, {:.0} ms\n",
                 f.agent,
                 f.cells[0],
                 f.cells[1],
+                f.solves,
                 f.iterations,
-                f.relative_change,
-                if f.stalled { " (round-off floor)" } else { "" },
+                f.relative_residual,
                 f.solve_time.as_secs_f64() * 1e3
             );
         }

@@ -1,4 +1,6 @@
-//! The Laplace solver: the harmonic potential of eq. 3 on the free cells of the mask.
+//! The reference Laplace solver (red-black SOR) and the flood fill that finds the free cells
+//! connected to the target. The production solver is [`super::multigrid`] with
+//! [`super::harmonic`]; this one is simple enough to trust, and the tests compare with it.
 //!
 //! We solve for `W = 1 - V` rather than `V`: `W = 0` on blocked cells and outside the grid,
 //! `W = 1` at the target cell, `∇²W = 0` elsewhere. Far from the target `V` is within 1e-6 of 1

@@ -1,13 +1,17 @@
 //! The harmonic guidance field of one agent (paper §II, eq. 3–4).
 //!
 //! The walls are rasterized into a configuration-space mask for the agent's radius
-//! ([`mask`]), Laplace's equation is solved on the free cells ([`laplace`]), and the result is
+//! ([`mask`]), Laplace's equation is solved on the free cells connected to the target by
+//! multigrid-preconditioned CG ([`multigrid`]) with nested solves of the deep regions
+//! ([`harmonic`]; [`laplace`] keeps a plain SOR solver as the reference), and the result is
 //! sampled smoothly anywhere in the box ([`sample`]); the kinematic path is the streamline of
 //! the normalized guidance from the start ([`streamline`]).
 
 pub mod grid;
+pub mod harmonic;
 pub mod laplace;
 pub mod mask;
+pub mod multigrid;
 pub mod sample;
 pub mod streamline;
 
@@ -20,9 +24,6 @@ pub use sample::Sampler;
 pub use streamline::Streamline;
 
 use crate::world::{Agent, World, all_wall_shapes};
-
-/// Most SOR sweeps before the solver gives up.
-pub const MAX_SWEEPS: usize = 200_000;
 
 /// Why a field could not be built for an agent.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -47,13 +48,17 @@ pub enum FieldError {
         /// The agent's radius, m.
         radius: f64,
     },
-    /// The solver did not converge.
-    #[error("agent `{agent}`: the Laplace solver failed: {source}")]
+    /// The solver did not reach the tolerance.
+    #[error(
+        "agent `{agent}`: the Laplace solver stopped at a relative residual of {relative_residual:e} after {iterations} iterations, above field.tolerance"
+    )]
     Solver {
         /// The agent's name.
         agent: String,
-        /// What the solver reported.
-        source: laplace::SolveError,
+        /// Iterations performed.
+        iterations: usize,
+        /// The residual reached.
+        relative_residual: f64,
     },
 }
 
@@ -66,13 +71,12 @@ pub struct HarmonicField {
     pub blocked: Vec<bool>,
     /// The target, m.
     pub target: [f64; 2],
-    /// SOR sweeps the solve took.
+    /// Conjugate gradient iterations over all solves.
     pub iterations: usize,
-    /// The largest relative per-cell change in the last sweep.
-    pub relative_change: f64,
-    /// Whether the solver stopped at its round-off floor (see [`laplace`]) rather than at
-    /// `field.tolerance`.
-    pub stalled: bool,
+    /// Solves: the first plus the nested ones for the deep regions (see [`harmonic`]).
+    pub solves: usize,
+    /// The worst final relative residual of the solves.
+    pub relative_residual: f64,
     /// Wall-clock time of the solve.
     pub solve_time: Duration,
 }
@@ -130,24 +134,28 @@ impl HarmonicField {
     pub fn solve(world: &World, agent: &Agent) -> Result<Self, FieldError> {
         let started = Instant::now();
         let space = FreeSpace::of(world, agent)?;
-        let solution = laplace::solve_sor(
+        let solution = harmonic::solve_w(
             &space.grid,
             &space.reachable,
             space.target_cell,
             world.field.tolerance,
-            MAX_SWEEPS,
-        )
-        .map_err(|source| FieldError::Solver {
-            agent: agent.name.clone(),
-            source,
-        })?;
+            None,
+        );
+        if solution.relative_residual.is_nan() || solution.relative_residual > world.field.tolerance
+        {
+            return Err(FieldError::Solver {
+                agent: agent.name.clone(),
+                iterations: solution.iterations,
+                relative_residual: solution.relative_residual,
+            });
+        }
         Ok(Self {
-            sampler: Sampler::new(space.grid, solution.w, solution.reachable),
+            sampler: Sampler::new(space.grid, solution.w, space.reachable),
             blocked: space.blocked,
             target: agent.target,
             iterations: solution.iterations,
-            relative_change: solution.relative_change,
-            stalled: solution.stalled,
+            solves: solution.solves,
+            relative_residual: solution.relative_residual,
             solve_time: started.elapsed(),
         })
     }

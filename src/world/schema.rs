@@ -81,7 +81,7 @@ pub struct FieldSettings {
     /// How the field's gradient becomes a guidance force.
     #[serde(default)]
     pub guidance: GuidanceKind,
-    /// Relative per-cell tolerance at which the Laplace solver stops.
+    /// Relative residual to which each Laplace solve is taken.
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
     /// The largest grid accepted, in cells (about 40 bytes of memory each, per agent).
@@ -210,7 +210,7 @@ fn default_cell() -> f64 {
     0.05
 }
 fn default_tolerance() -> f64 {
-    1e-9
+    1e-12
 }
 fn default_max_cells() -> u64 {
     super::validate::MAX_CELLS
