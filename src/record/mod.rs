@@ -28,7 +28,10 @@ use crate::sim::{AgentState, Simulation};
 use crate::world::{Wall, World, all_walls};
 
 /// Steps between two updates of the trail (which is re-logged whole).
-const TRAIL_EVERY: usize = 10;
+const TRAIL_EVERY: usize = 25;
+/// Most points in a logged trail: a longer one is thinned evenly (its last point kept), so a
+/// long run's recording grows linearly, not quadratically.
+const TRAIL_POINTS: usize = 2000;
 /// Wall-clock time between two flushes of the file, so that a run killed outright still leaves
 /// a `.partial` file that decodes up to its last few seconds.
 const FLUSH_EVERY: std::time::Duration = std::time::Duration::from_secs(1);
@@ -241,9 +244,14 @@ impl Recorder {
             }
             trail.push(p);
             if self.steps % TRAIL_EVERY == 1 || sim.finished() {
+                let stride = trail.len().div_ceil(TRAIL_POINTS);
+                let mut points: Vec<[f32; 2]> = trail.iter().step_by(stride).copied().collect();
+                if (trail.len() - 1) % stride != 0 {
+                    points.push(p);
+                }
                 rec.log(
                     format!("agents/{name}/trail"),
-                    &rerun::LineStrips2D::new([trail.clone()])
+                    &rerun::LineStrips2D::new([points])
                         .with_colors([rerun::Color::from_rgb(255, 170, 40)])
                         .with_radii([0.015]),
                 )?;
