@@ -27,7 +27,11 @@ fn the_maze_is_flat_in_f64_v_yet_every_sampled_streamline_reaches_the_target() {
             }
             let from = grid.center(i, j);
             let path = streamline(&field.sampler, from, agent.target, 300.0);
-            assert!(path.reached, "the streamline from {from:?} stops at {:?}", path.points.last());
+            assert!(
+                path.reached,
+                "the streamline from {from:?} stops at {:?}",
+                path.points.last()
+            );
             checked += 1;
         }
     }
