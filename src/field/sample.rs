@@ -5,6 +5,25 @@ use nalgebra::Vector2;
 
 use super::grid::Grid;
 
+/// Up to four cells and their interpolation weights, without allocating (sampling runs
+/// several times per agent and step).
+#[derive(Debug, Clone, Copy, Default)]
+struct Stencil {
+    cells: [(usize, f64); 4],
+    len: usize,
+}
+
+impl Stencil {
+    fn push(&mut self, k: usize, weight: f64) {
+        self.cells[self.len] = (k, weight);
+        self.len += 1;
+    }
+
+    fn cells(&self) -> &[(usize, f64)] {
+        &self.cells[..self.len]
+    }
+}
+
 /// `W` and its central-difference gradient at every cell centre, ready for interpolation.
 #[derive(Debug, Clone)]
 pub struct Sampler {
@@ -47,16 +66,16 @@ impl Sampler {
 
     /// The bilinear weights of the (up to four) reachable cell centres around `p`, renormalized
     /// over the reachable ones; empty when none of the four is reachable.
-    fn stencil(&self, p: [f64; 2]) -> Vec<(usize, f64)> {
+    fn stencil(&self, p: [f64; 2]) -> Stencil {
         let g = &self.grid;
         let fx = (p[0] - g.origin[0]) / g.cell - 0.5;
         let fy = (p[1] - g.origin[1]) / g.cell - 0.5;
+        let mut out = Stencil::default();
         if !(fx.is_finite() && fy.is_finite()) {
-            return Vec::new();
+            return out;
         }
         let (i0, j0) = (fx.floor(), fy.floor());
         let (tx, ty) = (fx - i0, fy - j0);
-        let mut out = Vec::with_capacity(4);
         let mut total = 0.0;
         for (di, dj, weight) in [
             (0, 0, (1.0 - tx) * (1.0 - ty)),
@@ -70,19 +89,19 @@ impl Sampler {
             }
             let k = g.index(i as usize, j as usize);
             if self.reachable[k] && weight > 0.0 {
-                out.push((k, weight));
+                out.push(k, weight);
                 total += weight;
             }
         }
         if total > 0.0 {
-            for (_, weight) in &mut out {
+            for (_, weight) in &mut out.cells[..out.len] {
                 *weight /= total;
             }
         } else if let Some((i, j)) = g.cell_of(p) {
             // Exactly on a centre line with the other cells blocked: the cell itself.
             let k = g.index(i, j);
             if self.reachable[k] {
-                out.push((k, 1.0));
+                out.push(k, 1.0);
             }
         }
         out
@@ -91,12 +110,14 @@ impl Sampler {
     /// `W = 1 - V` at `p`, if `p` is next to a reachable cell.
     pub fn w(&self, p: [f64; 2]) -> Option<f64> {
         let s = self.stencil(p);
+        let s = s.cells();
         (!s.is_empty()).then(|| s.iter().map(|&(k, a)| a * self.w[k]).sum())
     }
 
     /// `∇W = -∇V` at `p`, if `p` is next to a reachable cell.
     pub fn grad_w(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
         let s = self.stencil(p);
+        let s = s.cells();
         (!s.is_empty()).then(|| s.iter().map(|&(k, a)| self.grad_w[k] * a).sum())
     }
 
