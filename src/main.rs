@@ -8,7 +8,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
 
-use nadf::field::FreeSpace;
+use nadf::field::{FreeSpace, HarmonicField, export};
+use nadf::record::field_picture;
 use nadf::run::{RunError, RunOptions, run};
 use nadf::world::{Override, load};
 
@@ -51,6 +52,25 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         overrides: Vec<Override>,
     },
+    /// Solve one agent's harmonic field and export it: NumPy arrays and a picture.
+    Field {
+        /// The world file (TOML).
+        world: PathBuf,
+        /// The agent whose field to solve [default: the first].
+        #[arg(long)]
+        agent: Option<String>,
+        /// Write V as a float64 array of shape [nx, ny] (x index first) to this file, W = 1 - V
+        /// to FILE.w.npy and the cell mask (0 reachable, 1 blocked, 2 unreachable) to
+        /// FILE.mask.npy.
+        #[arg(long, value_name = "FILE.npy")]
+        npy: Option<PathBuf>,
+        /// Write a picture of the field (log10(1 - V), streamlines, start, target).
+        #[arg(long, value_name = "FILE.png")]
+        png: Option<PathBuf>,
+        /// Override a world value by dotted path (see `run`). Repeatable.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<Override>,
+    },
     /// Validate world files and print every problem found (file, line, key).
     Check {
         /// The world files.
@@ -69,6 +89,19 @@ fn main() -> ExitCode {
             overrides,
         } => run_command(&world, output, no_record, json, &overrides),
         Command::Check { worlds } => check_command(&worlds),
+        Command::Field {
+            world,
+            agent,
+            npy,
+            png,
+            overrides,
+        } => field_command(
+            &world,
+            agent.as_deref(),
+            npy.as_deref(),
+            png.as_deref(),
+            &overrides,
+        ),
     }
 }
 
@@ -152,6 +185,88 @@ fn run_command(
             ExitCode::from(FAILED)
         }
     }
+}
+
+fn field_command(
+    path: &Path,
+    agent: Option<&str>,
+    npy: Option<&Path>,
+    png: Option<&Path>,
+    overrides: &[Override],
+) -> ExitCode {
+    let world = match load(path, overrides) {
+        Ok(world) => world,
+        Err(errors) => {
+            eprintln!("{errors}");
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    let Some(agent) = (match agent {
+        Some(name) => world.agents.iter().find(|a| a.name == name),
+        None => world.agents.first(),
+    }) else {
+        let names: Vec<&str> = world.agents.iter().map(|a| a.name.as_str()).collect();
+        eprintln!(
+            "error: {}: no agent `{}`; the agents are: {}",
+            path.display(),
+            agent.unwrap_or_default(),
+            names.join(", ")
+        );
+        return ExitCode::from(BAD_INPUT);
+    };
+    let field = match HarmonicField::solve(&world, agent) {
+        Ok(field) => field,
+        Err(e) => {
+            eprintln!("error: {}: {e}", path.display());
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    let grid = field.grid();
+    let reachable = field
+        .sampler
+        .reachable_cells()
+        .iter()
+        .filter(|r| **r)
+        .count();
+    let blocked = field.blocked.iter().filter(|b| **b).count();
+    println!(
+        "field of {}: {} x {} cells of {} m ({reachable} reachable, {blocked} blocked, {} unreachable)",
+        agent.name,
+        grid.nx,
+        grid.ny,
+        grid.cell,
+        grid.len() - reachable - blocked
+    );
+    println!(
+        "solve: {:.1} ms, {} solve(s), {} CG iterations, relative residual {:.1e}",
+        field.solve_time.as_secs_f64() * 1e3,
+        field.solves,
+        field.iterations,
+        field.relative_residual
+    );
+    println!(
+        "1 - V at the start: {:.3e}",
+        field.one_minus_potential(agent.start)
+    );
+    let mut outputs: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    if let Some(npy) = npy {
+        let [v, w, mask] = export::npy_paths(npy);
+        outputs.push((v, export::potential_npy(&field)));
+        outputs.push((w, export::one_minus_potential_npy(&field)));
+        outputs.push((mask, export::mask_npy(&field)));
+    }
+    if let Some(png) = png {
+        let (rgb, width, height) = field_picture(&field, agent);
+        outputs.push((png.to_path_buf(), export::png(&rgb, width, height)));
+    }
+    for (out, bytes) in outputs {
+        if let Err(e) = export::write(&out, &bytes) {
+            eprintln!("error: cannot write {}: {e}", out.display());
+            return ExitCode::from(FAILED);
+        }
+        println!("wrote {}", out.display());
+    }
+    ExitCode::SUCCESS
 }
 
 fn check_command(paths: &[PathBuf]) -> ExitCode {

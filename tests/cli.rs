@@ -241,3 +241,60 @@ fn an_intractable_task_is_bad_input_naming_the_agent() {
         "{stderr}"
     );
 }
+
+#[test]
+fn field_exports_numpy_arrays_and_a_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("room-two-dividers.toml");
+    let world = world.to_str().unwrap();
+    let out = nadf(
+        dir.path(),
+        &["field", world, "--npy", "room.npy", "--png", "room.png"],
+    );
+    common::assert_success(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("201 x 201 cells") && stdout.contains("CG iterations"),
+        "{stdout}"
+    );
+
+    let npy = |name: &str| {
+        let bytes = std::fs::read(dir.path().join(name)).unwrap();
+        let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        let header = String::from_utf8(bytes[10..10 + header_len].to_vec()).unwrap();
+        (header, bytes[10 + header_len..].to_vec())
+    };
+    let (header, v) = npy("room.npy");
+    assert!(
+        header.contains("'descr': '<f8'") && header.contains("'shape': (201, 201)"),
+        "{header}"
+    );
+    assert_eq!(v.len(), 201 * 201 * 8);
+    let (header, w) = npy("room.w.npy");
+    assert!(header.contains("'<f8'"));
+    let (header, mask) = npy("room.mask.npy");
+    assert!(header.contains("'|u1'"), "{header}");
+    // V + W = 1 where W is not tiny, and the mask says which cells are blocked.
+    for k in (0..201 * 201).step_by(97) {
+        let v = f64::from_le_bytes(v[8 * k..8 * k + 8].try_into().unwrap());
+        let w = f64::from_le_bytes(w[8 * k..8 * k + 8].try_into().unwrap());
+        assert!((v + w - 1.0).abs() < 1e-15);
+        assert!(mask[k] <= 2);
+        if mask[k] == 1 {
+            assert_eq!(w, 0.0);
+        }
+    }
+    assert!(mask.contains(&1) && mask.contains(&0));
+
+    let png = std::fs::File::open(dir.path().join("room.png")).unwrap();
+    let reader = png::Decoder::new(std::io::BufReader::new(png))
+        .read_info()
+        .unwrap();
+    assert_eq!((reader.info().width, reader.info().height), (804, 804));
+
+    let out = nadf(dir.path(), &["field", world, "--agent", "nobody"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("no agent `nobody`; the agents are: robot")
+    );
+}

@@ -7,6 +7,7 @@
 //! sampled smoothly anywhere in the box ([`sample`]); the kinematic path is the streamline of
 //! the normalized guidance from the start ([`streamline`]).
 
+pub mod export;
 pub mod grid;
 pub mod harmonic;
 pub mod laplace;

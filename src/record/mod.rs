@@ -19,6 +19,9 @@
 
 mod blueprint;
 mod colormap;
+mod picture;
+
+pub use picture::field_picture;
 
 use std::path::{Path, PathBuf};
 

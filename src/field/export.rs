@@ -1,0 +1,139 @@
+//! Writing a solved field for other tools: NumPy `.npy` arrays (read with `numpy.load`).
+//!
+//! Arrays have shape `[nx, ny]`, x index first: element `[i, j]` is cell `(i, j)`, whose centre
+//! is `grid.origin + ((i + ½)·h, (j + ½)·h)`.
+
+use super::HarmonicField;
+use super::grid::Grid;
+
+/// The cell classes of the mask array.
+pub mod mask {
+    /// A free cell connected to the target.
+    pub const REACHABLE: u8 = 0;
+    /// A blocked cell: the agent's centre cannot be there.
+    pub const BLOCKED: u8 = 1;
+    /// A free cell no path connects to the target.
+    pub const UNREACHABLE: u8 = 2;
+}
+
+/// An `.npy` file (format 1.0) holding a C-ordered `[nx, ny]` array of `descr` elements.
+fn npy(grid: &Grid, descr: &str, element_bytes: usize, data: impl Fn(usize) -> Vec<u8>) -> Vec<u8> {
+    let mut header = format!(
+        "{{'descr': '{descr}', 'fortran_order': False, 'shape': ({}, {}), }}",
+        grid.nx, grid.ny
+    );
+    // Magic (6) + version (2) + length (2) + header + newline, padded to a multiple of 64.
+    let unpadded = 10 + header.len() + 1;
+    header.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
+    header.push('\n');
+    let mut out = Vec::with_capacity(10 + header.len() + grid.len() * element_bytes);
+    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    for i in 0..grid.nx {
+        for j in 0..grid.ny {
+            out.extend_from_slice(&data(grid.index(i, j)));
+        }
+    }
+    out
+}
+
+/// `V = 1 − W` per cell as little-endian float64 (exactly 1 where `W` is below 1e-16).
+pub fn potential_npy(field: &HarmonicField) -> Vec<u8> {
+    let w = field.sampler.w_cells();
+    npy(field.grid(), "<f8", 8, |k| {
+        (1.0 - w[k]).to_le_bytes().to_vec()
+    })
+}
+
+/// `W = 1 − V` per cell as little-endian float64, with full relative precision.
+pub fn one_minus_potential_npy(field: &HarmonicField) -> Vec<u8> {
+    let w = field.sampler.w_cells();
+    npy(field.grid(), "<f8", 8, |k| w[k].to_le_bytes().to_vec())
+}
+
+/// The mask as uint8: [`mask::REACHABLE`], [`mask::BLOCKED`] or [`mask::UNREACHABLE`].
+pub fn mask_npy(field: &HarmonicField) -> Vec<u8> {
+    let reachable = field.sampler.reachable_cells();
+    npy(field.grid(), "|u1", 1, |k| {
+        vec![if field.blocked[k] {
+            mask::BLOCKED
+        } else if reachable[k] {
+            mask::REACHABLE
+        } else {
+            mask::UNREACHABLE
+        }]
+    })
+}
+
+/// Writes `bytes` to `path` (through a temporary file, so a failure leaves no partial file).
+pub fn write(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
+    crate::run::write_atomically(path, bytes)
+}
+
+/// The paths of the three arrays `--npy FILE` writes: `FILE` (V), `FILE.w.npy` and
+/// `FILE.mask.npy` with `FILE`'s `.npy` extension replaced.
+pub fn npy_paths(path: &std::path::Path) -> [std::path::PathBuf; 3] {
+    let stem = path.with_extension("");
+    let with = |suffix: &str| {
+        let mut s = stem.as_os_str().to_owned();
+        s.push(suffix);
+        std::path::PathBuf::from(s)
+    };
+    [path.to_path_buf(), with(".w.npy"), with(".mask.npy")]
+}
+
+/// Encodes RGB bytes (`width × height`, top row first) as a PNG.
+pub fn png(rgb: &[u8], width: u32, height: u32) -> Vec<u8> {
+    let mut out = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut out, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().expect("writing to memory");
+        writer.write_image_data(rgb).expect("writing to memory");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npy_headers_are_aligned_and_the_data_is_x_major() {
+        let grid = Grid::covering([0.3, 0.2], 0.1);
+        let bytes = npy(&grid, "|u1", 1, |k| vec![k as u8]);
+        assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+        let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        assert_eq!((10 + header_len) % 64, 0);
+        let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+        assert!(
+            header.contains("'shape': (3, 2)") && header.ends_with('\n'),
+            "{header}"
+        );
+        // [i, j] order: (0,0), (0,1), (1,0), … with k = j·nx + i.
+        assert_eq!(&bytes[10 + header_len..], &[0, 3, 1, 4, 2, 5]);
+    }
+
+    #[test]
+    fn npy_paths_put_the_extra_arrays_beside_the_first() {
+        let [v, w, m] = npy_paths(std::path::Path::new("out/field.npy"));
+        assert_eq!(v, std::path::Path::new("out/field.npy"));
+        assert_eq!(w, std::path::Path::new("out/field.w.npy"));
+        assert_eq!(m, std::path::Path::new("out/field.mask.npy"));
+    }
+
+    #[test]
+    fn png_round_trips() {
+        let rgb: Vec<u8> = (0..2 * 3 * 3).map(|v| v as u8 * 10).collect();
+        let bytes = png(&rgb, 2, 3);
+        let mut reader = png::Decoder::new(std::io::Cursor::new(bytes))
+            .read_info()
+            .unwrap();
+        let mut out = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut out).unwrap();
+        assert_eq!((info.width, info.height), (2, 3));
+        assert_eq!(&out[..info.buffer_size()], &rgb[..]);
+    }
+}
