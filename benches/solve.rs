@@ -1,0 +1,96 @@
+//! The harmonic field solve: multigrid-preconditioned CG with nested deep-region solves
+//! (`harmonic::solve_w`) against the red-black SOR reference, on the room with two dividers at
+//! 256² to 2048² cells and on the maze; and a warm-started re-solve after one divider moves by
+//! one cell. Single-threaded. Run with `cargo bench --bench solve`.
+
+use std::path::Path;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use nadf::field::{FreeSpace, harmonic, laplace};
+use nadf::world::{Override, load};
+
+/// The free space of the first agent of a shipped world, with overrides.
+fn space(world: &str, overrides: &[String]) -> FreeSpace {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("worlds")
+        .join(world);
+    let overrides: Vec<Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
+    let world = load(&path, &overrides).unwrap();
+    FreeSpace::of(&world, &world.agents[0]).unwrap()
+}
+
+fn room(cells: usize, extra: &[String]) -> FreeSpace {
+    let mut overrides = vec![format!("field.cell={}", 10.0 / cells as f64)];
+    overrides.extend_from_slice(extra);
+    space("room-two-dividers.toml", &overrides)
+}
+
+fn solves(c: &mut Criterion) {
+    let mut group = c.benchmark_group("room");
+    group.sample_size(10);
+    for cells in [256, 512, 1024, 2048] {
+        let s = room(cells, &[]);
+        group.bench_with_input(BenchmarkId::new("multigrid", cells), &s, |b, s| {
+            b.iter(|| harmonic::solve_w(&s.grid, &s.reachable, s.target_cell, 1e-10, None))
+        });
+        // The reference only where it finishes in reasonable time.
+        if cells <= 512 {
+            group.bench_with_input(BenchmarkId::new("sor", cells), &s, |b, s| {
+                b.iter(|| {
+                    laplace::solve_sor(&s.grid, &s.reachable, s.target_cell, 1e-9, 1_000_000)
+                        .unwrap()
+                })
+            });
+        }
+    }
+    group.finish();
+
+    let mut group = c.benchmark_group("maze");
+    group.sample_size(10);
+    let s = space("maze.toml", &[]);
+    group.bench_function("multigrid", |b| {
+        b.iter(|| harmonic::solve_w(&s.grid, &s.reachable, s.target_cell, 1e-10, None))
+    });
+    group.finish();
+
+    // One divider moves by one cell: a cold solve of the new field against one warm-started
+    // from the old field.
+    let mut group = c.benchmark_group("re-solve-512");
+    group.sample_size(10);
+    let before = room(512, &[]);
+    let old = harmonic::solve_w(
+        &before.grid,
+        &before.reachable,
+        before.target_cell,
+        1e-10,
+        None,
+    )
+    .w;
+    let after = room(512, &[format!("walls.1.center.0={}", 6.75 + 10.0 / 512.0)]);
+    group.bench_function("cold", |b| {
+        b.iter(|| {
+            harmonic::solve_w(
+                &after.grid,
+                &after.reachable,
+                after.target_cell,
+                1e-10,
+                None,
+            )
+        })
+    });
+    group.bench_function("warm", |b| {
+        b.iter(|| {
+            harmonic::solve_w(
+                &after.grid,
+                &after.reachable,
+                after.target_cell,
+                1e-10,
+                Some(&old),
+            )
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, solves);
+criterion_main!(benches);
