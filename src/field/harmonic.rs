@@ -68,16 +68,9 @@ pub fn solve_w(
             .zip(&w)
             .map(|(u, w)| *u && *w < depth)
             .collect();
-        if !deep.iter().any(|d| *d) {
+        let Some(stats) = solve_deep(grid, &deep, &mut w, depth, tolerance) else {
             break;
-        }
-        let mut scaled: Vec<f64> = w.iter().map(|w| w.max(0.0) / depth).collect();
-        let stats = multigrid::solve(grid, &deep, &mut scaled, tolerance, MAX_ITERATIONS);
-        for ((w, s), d) in w.iter_mut().zip(&scaled).zip(&deep) {
-            if *d {
-                *w = s * depth;
-            }
-        }
+        };
         out.iterations += stats.iterations;
         out.solves += 1;
         out.relative_residual = out.relative_residual.max(stats.relative_residual);
@@ -85,6 +78,57 @@ pub fn solve_w(
     }
     out.w = w;
     out
+}
+
+/// Re-solves `W` on the `deep` cells alone, scaled by `1/depth`, with the other cells as
+/// Dirichlet values. Works on the bounding box of the deep cells plus a one-cell margin (which
+/// holds their fixed neighbours), so deeper levels cost less. `None` when no cell is deep.
+fn solve_deep(
+    grid: &Grid,
+    deep: &[bool],
+    w: &mut [f64],
+    depth: f64,
+    tolerance: f64,
+) -> Option<multigrid::Stats> {
+    let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            if deep[grid.index(i, j)] {
+                lo = [lo[0].min(i), lo[1].min(j)];
+                hi = [hi[0].max(i), hi[1].max(j)];
+            }
+        }
+    }
+    if lo[0] == usize::MAX {
+        return None;
+    }
+    let (i0, j0) = (lo[0].saturating_sub(1), lo[1].saturating_sub(1));
+    let (i1, j1) = ((hi[0] + 1).min(grid.nx - 1), (hi[1] + 1).min(grid.ny - 1));
+    let sub = Grid {
+        nx: i1 - i0 + 1,
+        ny: j1 - j0 + 1,
+        cell: grid.cell,
+        origin: grid.center(i0, j0).map(|c| c - 0.5 * grid.cell),
+    };
+    let mut sub_deep = vec![false; sub.len()];
+    let mut scaled = vec![0.0; sub.len()];
+    for j in 0..sub.ny {
+        for i in 0..sub.nx {
+            let (k, s) = (grid.index(i0 + i, j0 + j), sub.index(i, j));
+            sub_deep[s] = deep[k];
+            scaled[s] = w[k].max(0.0) / depth;
+        }
+    }
+    let stats = multigrid::solve(&sub, &sub_deep, &mut scaled, tolerance, MAX_ITERATIONS);
+    for j in 0..sub.ny {
+        for i in 0..sub.nx {
+            let s = sub.index(i, j);
+            if sub_deep[s] {
+                w[grid.index(i0 + i, j0 + j)] = scaled[s] * depth;
+            }
+        }
+    }
+    Some(stats)
 }
 
 #[cfg(test)]
