@@ -105,6 +105,14 @@ fn main() -> ExitCode {
     }
 }
 
+/// Loads a world, or prints every problem in it and gives the bad-input status.
+fn load_world(path: &Path, overrides: &[Override]) -> Result<nadf::world::World, ExitCode> {
+    load(path, overrides).map_err(|errors| {
+        eprintln!("{errors}");
+        ExitCode::from(BAD_INPUT)
+    })
+}
+
 fn run_command(
     path: &Path,
     output: Option<PathBuf>,
@@ -112,12 +120,9 @@ fn run_command(
     json: Option<PathBuf>,
     overrides: &[Override],
 ) -> ExitCode {
-    let world = match load(path, overrides) {
+    let world = match load_world(path, overrides) {
         Ok(world) => world,
-        Err(errors) => {
-            eprintln!("{errors}");
-            return ExitCode::from(BAD_INPUT);
-        }
+        Err(code) => return code,
     };
     let recording = (!no_record).then(|| {
         output.unwrap_or_else(|| {
@@ -194,12 +199,9 @@ fn field_command(
     png: Option<&Path>,
     overrides: &[Override],
 ) -> ExitCode {
-    let world = match load(path, overrides) {
+    let world = match load_world(path, overrides) {
         Ok(world) => world,
-        Err(errors) => {
-            eprintln!("{errors}");
-            return ExitCode::from(BAD_INPUT);
-        }
+        Err(code) => return code,
     };
     let Some(agent) = (match agent {
         Some(name) => world.agents.iter().find(|a| a.name == name),
