@@ -105,12 +105,21 @@ fn main() -> ExitCode {
     }
 }
 
-/// Loads a world, or prints every problem in it and gives the bad-input status.
+/// Loads a world, or prints every problem in it and gives the bad-input status. Prints the
+/// world's warnings.
 fn load_world(path: &Path, overrides: &[Override]) -> Result<nadf::world::World, ExitCode> {
-    load(path, overrides).map_err(|errors| {
+    let world = load(path, overrides).map_err(|errors| {
         eprintln!("{errors}");
         ExitCode::from(BAD_INPUT)
-    })
+    })?;
+    print_warnings(path, &world);
+    Ok(world)
+}
+
+fn print_warnings(path: &Path, world: &nadf::world::World) {
+    for w in nadf::world::warnings(path, world) {
+        eprintln!("warning: {w}");
+    }
 }
 
 fn run_command(
@@ -282,6 +291,7 @@ fn check_command(paths: &[PathBuf]) -> ExitCode {
                 continue;
             }
         };
+        print_warnings(path, &world);
         // The file is well formed; is every agent's task tractable on its grid?
         let problems: Vec<String> = world
             .agents

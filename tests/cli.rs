@@ -298,3 +298,52 @@ fn field_exports_numpy_arrays_and_a_picture() {
         String::from_utf8_lossy(&out.stderr).contains("no agent `nobody`; the agents are: robot")
     );
 }
+
+#[test]
+fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, &[&str], &[&str]); 3] = [
+        (
+            "room-speed-limit.toml",
+            &["plots/robot/speed_limited"],
+            &["plots/robot/clamping", "plots/robot/beta_x"],
+        ),
+        (
+            "room-drift-bias.toml",
+            &[
+                "plots/robot/clamping",
+                "plots/robot/beta_x",
+                "plots/robot/beta_y",
+                "agents/robot/events",
+            ],
+            &["plots/robot/speed_limited", "agents/robot/sensed_walls"],
+        ),
+        (
+            "room-drift-noise.toml",
+            &["plots/robot/clamping", "agents/robot/sensed_walls"],
+            &["plots/robot/beta_x"],
+        ),
+    ];
+    for (world, present, absent) in cases {
+        let path = world_path(world);
+        let out = nadf(
+            dir.path(),
+            &[
+                "run",
+                path.to_str().unwrap(),
+                "-o",
+                "r.rrd",
+                "--set",
+                "duration=8",
+            ],
+        );
+        common::assert_success(&out);
+        let (entities, _) = decode(&dir.path().join("r.rrd"));
+        for e in present {
+            assert!(entities.contains(*e), "{world}: no `{e}` in {entities:?}");
+        }
+        for e in absent {
+            assert!(!entities.contains(*e), "{world}: unexpected `{e}`");
+        }
+    }
+}

@@ -9,7 +9,7 @@ use nadf::sim::Simulation;
 fn nadf_energy_never_increases_with_gradient_guidance() {
     let world = common::world("open-room-gradient.toml", &[]);
     let agent = &world.agents[0];
-    let (k, m) = (agent.controller.k, agent.mass);
+    let (k, m) = (agent.controller.k(), agent.mass);
     let mut sim = Simulation::new(&world).unwrap();
     let cell = world.field.cell;
     let energy0 = k * sim.agents[0].field.potential(agent.start);

@@ -32,7 +32,7 @@ fn defaults_fill_in_what_the_file_leaves_out() {
     assert_eq!(w.field.cell, 0.05);
     assert_eq!(w.field.guidance, GuidanceKind::Normalized);
     let a = &w.agents[0];
-    assert_eq!((a.radius, a.mass, a.controller.k), (0.2, 1.0, 1.0));
+    assert_eq!((a.radius, a.mass, a.controller.k()), (0.2, 1.0, 1.0));
     assert_eq!(a.controller.kind, ControllerKind::Nadf);
 }
 
@@ -50,7 +50,7 @@ fn overrides_set_values_index_arrays_and_create_tables() {
     .collect();
     let w = load_str(MINIMAL, Path::new("w.toml"), &sets).unwrap();
     assert_eq!(w.agents[0].controller.kind, ControllerKind::Viscous);
-    assert_eq!(w.agents[0].controller.b, 0.7);
+    assert_eq!(w.agents[0].controller.b, Some(0.7));
     assert_eq!(w.field.guidance, GuidanceKind::Gradient);
     assert_eq!(w.agents[0].target, [3.0, 2.5]);
     assert_eq!(w.name(), "renamed");

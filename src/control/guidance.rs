@@ -2,7 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::unit;
+use super::{ControlInput, ControlLaw, unit};
 
 /// How the gradient becomes a force.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,6 +54,13 @@ impl Guidance {
                 }
             }
         }
+    }
+}
+
+impl<const N: usize> ControlLaw<N> for Guidance {
+    fn force(&self, input: &ControlInput<N>) -> SVector<f64, N> {
+        let g = input.gradient.unwrap_or_else(SVector::zeros);
+        Guidance::force(self, input.offset.norm(), &g)
     }
 }
 

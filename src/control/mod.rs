@@ -1,18 +1,28 @@
-//! The control laws: how the guidance field and a damping law become the force on a body.
+//! The control laws: how the guidance field becomes the force on a body.
 //!
 //! Every law is stated in R^N as in the paper (N = 2 for a planar body, N = 1 for a pendulum
 //! joint) on nalgebra vectors; the one conversion to Rapier's `glam` types is in `sim`.
 //!
-//! A controller is a guidance force ([`Guidance`], from `g = ∇V`) plus a damping force from a
-//! [`Damping`] law ([`Viscous`], eq. 1, or [`Nadf`], eq. 9–10). The total is what the simulation
-//! applies: `F = F_g + F_d` (eq. 1 and eq. 34 with the signs of the design page).
+//! Each law is one [`ControlLaw`]: the guidance force ([`Guidance`]), a damping law
+//! ([`Viscous`], eq. 1, or [`Nadf`], eq. 9–10), the sliding-mode baseline ([`SlidingMode`],
+//! eq. 72–73) and the clamping control ([`Clamp`], eq. 35). A [`Controller`] sums its laws
+//! (eq. 36: `F = -B_d M - K ∇V - K_c F_c`), adds the iterative bias ([`Bias`], eq. 48–50) and
+//! applies the speed limit ([`SpeedLimit`], §VI.2) last.
 
+mod bias;
+mod clamp;
 mod guidance;
 mod nadf;
+mod sliding_mode;
+mod speed_limit;
 mod viscous;
 
+pub use bias::Bias;
+pub use clamp::Clamp;
 pub use guidance::{Guidance, GuidanceMode};
-pub use nadf::Nadf;
+pub use nadf::{Nadf, step};
+pub use sliding_mode::SlidingMode;
+pub use speed_limit::SpeedLimit;
 pub use viscous::Viscous;
 
 use nalgebra::SVector;
@@ -37,62 +47,132 @@ pub fn unit<const N: usize>(g: &SVector<f64, N>) -> Option<SVector<f64, N>> {
     Some(scaled / scaled.norm())
 }
 
-/// A damping law: the force that manages the body's inertia, given its velocity and the
-/// gradient of the guidance potential at its position.
-pub trait Damping<const N: usize>: Send + Sync {
-    /// The damping force `F_d`, N, for velocity `v` (m/s) where the gradient is `g = ∇V`.
-    /// Never returns a non-finite vector for finite inputs.
-    fn force(&self, v: &SVector<f64, N>, g: &SVector<f64, N>) -> SVector<f64, N>;
+/// What a control law sees at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlInput<const N: usize> {
+    /// `x - x_T`: the body's position relative to its target, m.
+    pub offset: SVector<f64, N>,
+    /// The body's velocity `v`, m/s.
+    pub velocity: SVector<f64, N>,
+    /// The gradient `g = ∇V` of the guidance potential at the body, 1/m; `None` where the field
+    /// is undefined (then guidance is zero and NADF damps like viscous damping).
+    pub gradient: Option<SVector<f64, N>>,
+    /// The control period, s.
+    pub dt: f64,
 }
 
-/// Guidance plus damping for one body.
+/// One term of a control law: a force from the body's state and the guidance.
+pub trait ControlLaw<const N: usize>: Send + Sync {
+    /// The force, N. Never returns a non-finite vector for finite inputs.
+    fn force(&self, input: &ControlInput<N>) -> SVector<f64, N>;
+}
+
+/// What a controller did in one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlOutput<const N: usize> {
+    /// The control force to apply, N (finite: zero replaces a non-finite sum).
+    pub force: SVector<f64, N>,
+    /// Whether the clamping control acted.
+    pub clamping: bool,
+    /// Whether the speed limit removed part of the force.
+    pub speed_limited: bool,
+    /// Whether the bias β was updated at the end of this step (a settling instant).
+    pub bias_updated: bool,
+}
+
+/// The whole controller of one body.
 pub struct Controller<const N: usize> {
-    /// The guidance force law.
-    pub guidance: Guidance,
-    /// The damping law.
-    pub damping: Box<dyn Damping<N>>,
+    /// The terms summed into the control force: guidance and a damping law, or sliding mode.
+    pub laws: Vec<Box<dyn ControlLaw<N>>>,
+    /// The clamping control, if any.
+    pub clamp: Option<Clamp>,
+    /// The iterative bias, if any.
+    pub bias: Option<Bias<N>>,
+    /// The speed limit, if any.
+    pub speed_limit: Option<SpeedLimit>,
 }
 
 impl<const N: usize> Controller<N> {
-    /// The total control force, N, at distance `distance` (m) from the target with velocity `v`
-    /// and gradient `g` (`None` where the field is undefined: then only damping acts, with
-    /// NADF's viscous fallback).
-    pub fn force(
-        &self,
-        distance: f64,
-        v: &SVector<f64, N>,
-        g: Option<&SVector<f64, N>>,
-    ) -> SVector<f64, N> {
-        let zero = SVector::<f64, N>::zeros();
-        let g = g.copied().unwrap_or(zero);
-        let total = self.guidance.force(distance, &g) + self.damping.force(v, &g);
-        if total.iter().all(|c| c.is_finite()) {
+    /// A controller that only sums `laws`.
+    pub fn new(laws: Vec<Box<dyn ControlLaw<N>>>) -> Self {
+        Self {
+            laws,
+            clamp: None,
+            bias: None,
+            speed_limit: None,
+        }
+    }
+
+    /// The control force for one step, and what acted. Updates the bias's settling detector.
+    pub fn step(&mut self, input: &ControlInput<N>) -> ControlOutput<N> {
+        let mut total: SVector<f64, N> = self.laws.iter().map(|law| law.force(input)).sum();
+        let mut clamping = false;
+        if let Some(clamp) = &self.clamp {
+            clamping = clamp.active(input);
+            total += clamp.force(input);
+        }
+        if let Some(bias) = &self.bias {
+            total += bias.beta();
+        }
+        let mut speed_limited = false;
+        if let Some(limit) = &self.speed_limit {
+            (total, speed_limited) = limit.limit(total, &input.velocity, input.dt);
+        }
+        let force = if total.iter().all(|c| c.is_finite()) {
             total
         } else {
-            zero
+            SVector::zeros()
+        };
+        let bias_updated = self
+            .bias
+            .as_mut()
+            .is_some_and(|bias| bias.observe(input, &force));
+        ControlOutput {
+            force,
+            clamping,
+            speed_limited,
+            bias_updated,
         }
+    }
+
+    /// The current bias β, N, if the controller has one.
+    pub fn beta(&self) -> Option<SVector<f64, N>> {
+        self.bias.as_ref().map(Bias::beta)
     }
 }
 
 impl Controller<2> {
-    /// The controller a world file's `[agents.controller]` table describes.
-    pub fn from_settings(settings: &ControllerSettings, guidance: GuidanceKind) -> Self {
-        let mode = match guidance {
-            GuidanceKind::Normalized => GuidanceMode::Normalized {
-                capture_radius: settings.capture_radius,
+    /// The controller a world file's `[agents.controller]` table describes (validated: the
+    /// parameters its kind needs are present) for a body of `mass` kg.
+    pub fn from_settings(settings: &ControllerSettings, guidance: GuidanceKind, mass: f64) -> Self {
+        let guidance = Guidance {
+            k: settings.k(),
+            mode: match guidance {
+                GuidanceKind::Normalized => GuidanceMode::Normalized {
+                    capture_radius: settings.capture_radius,
+                },
+                GuidanceKind::Gradient => GuidanceMode::Gradient,
             },
-            GuidanceKind::Gradient => GuidanceMode::Gradient,
         };
-        let damping: Box<dyn Damping<2>> = match settings.kind {
-            ControllerKind::Nadf => Box::new(Nadf { b_d: settings.b }),
-            ControllerKind::Viscous => Box::new(Viscous { b: settings.b }),
+        let b = settings.b.unwrap_or(0.0);
+        let laws: Vec<Box<dyn ControlLaw<2>>> = match settings.kind {
+            ControllerKind::Nadf => vec![Box::new(guidance), Box::new(Nadf { b_d: b })],
+            ControllerKind::Viscous => vec![Box::new(guidance), Box::new(Viscous { b })],
+            ControllerKind::SlidingMode => vec![Box::new(SlidingMode {
+                vd: settings.vd.unwrap_or(0.0),
+                f0: settings.f0.unwrap_or(0.0),
+                capture_radius: settings.capture_radius,
+            })],
         };
         Self {
-            guidance: Guidance {
-                k: settings.k,
-                mode,
-            },
-            damping,
+            laws,
+            clamp: settings.clamp.map(|c| Clamp {
+                kc: c.kc,
+                sigma: c.sigma,
+                mass,
+            }),
+            bias: settings.bias.map(|b| Bias::new(b.alpha, b.dwell)),
+            speed_limit: settings.speed_limit.map(|v_max| SpeedLimit { v_max, mass }),
         }
     }
 }
@@ -100,7 +180,31 @@ impl Controller<2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::world::{BiasSettings, ClampSettings};
     use nalgebra::Vector2;
+
+    fn settings(kind: ControllerKind) -> ControllerSettings {
+        ControllerSettings {
+            kind,
+            k: Some(1.0),
+            b: Some(10.0),
+            capture_radius: 0.25,
+            vd: None,
+            f0: None,
+            speed_limit: None,
+            clamp: None,
+            bias: None,
+        }
+    }
+
+    fn input(offset: [f64; 2], velocity: [f64; 2], gradient: Option<[f64; 2]>) -> ControlInput<2> {
+        ControlInput {
+            offset: Vector2::from(offset),
+            velocity: Vector2::from(velocity),
+            gradient: gradient.map(Vector2::from),
+            dt: 0.01,
+        }
+    }
 
     #[test]
     fn unit_survives_tiny_gradients_and_rejects_zero_and_nan() {
@@ -113,22 +217,56 @@ mod tests {
 
     #[test]
     fn controller_never_returns_non_finite_forces() {
-        let c = Controller::from_settings(
-            &ControllerSettings {
-                kind: ControllerKind::Nadf,
-                k: 1.0,
-                b: 10.0,
-                capture_radius: 0.25,
-            },
-            GuidanceKind::Gradient,
+        let mut c =
+            Controller::from_settings(&settings(ControllerKind::Nadf), GuidanceKind::Gradient, 1.0);
+        let out = c.step(&input([1.0, 0.0], [1.0, 0.0], Some([f64::MAX, f64::MAX])));
+        assert!(out.force.iter().all(|x| x.is_finite()));
+        let out = c.step(&input([1.0, 0.0], [f64::NAN, 0.0], None));
+        assert_eq!(out.force, Vector2::zeros());
+    }
+
+    #[test]
+    fn nadf_controller_is_guidance_plus_damping_plus_clamp_plus_bias() {
+        let mut s = settings(ControllerKind::Nadf);
+        s.clamp = Some(ClampSettings {
+            kc: 10.0,
+            sigma: 0.5,
+        });
+        s.bias = Some(BiasSettings {
+            alpha: 0.05,
+            dwell: 0.5,
+        });
+        let mut c = Controller::from_settings(&s, GuidanceKind::Normalized, 1.0);
+        // Inside σ, moving away along +x, gradient +x (uphill): guidance -K·0.2/0.25, NADF
+        // -B_d·v, clamp -K_c·e.
+        let out = c.step(&input([0.2, 0.0], [0.1, 0.0], Some([1.0, 0.0])));
+        let expected = -0.8 - 1.0 - 2.0;
+        assert!(
+            (out.force - Vector2::new(expected, 0.0)).norm() < 1e-12,
+            "{}",
+            out.force
         );
-        let f = c.force(
-            1.0,
-            &Vector2::new(1.0, 0.0),
-            Some(&Vector2::new(f64::MAX, f64::MAX)),
-        );
-        assert!(f.iter().all(|x| x.is_finite()));
-        let f = c.force(1.0, &Vector2::new(f64::NAN, 0.0), None);
-        assert_eq!(f, Vector2::zeros());
+        assert!(out.clamping && !out.speed_limited && !out.bias_updated);
+        assert_eq!(c.beta(), Some(Vector2::zeros()));
+    }
+
+    #[test]
+    fn sliding_mode_controller_has_no_separate_guidance() {
+        let mut s = settings(ControllerKind::SlidingMode);
+        (s.k, s.b, s.vd, s.f0) = (None, None, Some(2.0), Some(50.0));
+        let mut c = Controller::from_settings(&s, GuidanceKind::Normalized, 1.0);
+        let out = c.step(&input([5.0, 0.0], [0.0, 0.0], Some([1.0, 0.0])));
+        assert_eq!(out.force, Vector2::new(-50.0, 0.0));
+    }
+
+    #[test]
+    fn the_speed_limit_applies_to_the_whole_force() {
+        let mut s = settings(ControllerKind::Nadf);
+        s.speed_limit = Some(5.0);
+        let mut c = Controller::from_settings(&s, GuidanceKind::Normalized, 1.0);
+        // Moving down the guidance at the limit: the guidance's push is dropped.
+        let out = c.step(&input([5.0, 0.0], [-5.0, 0.0], Some([1.0, 0.0])));
+        assert!(out.speed_limited);
+        assert!(out.force.norm() < 1e-12, "{}", out.force);
     }
 }

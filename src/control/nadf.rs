@@ -9,7 +9,7 @@
 
 use nalgebra::SVector;
 
-use super::{Damping, unit};
+use super::{ControlInput, ControlLaw, unit};
 
 /// NADF damping.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,9 +40,22 @@ impl Nadf {
     }
 }
 
-impl<const N: usize> Damping<N> for Nadf {
-    fn force(&self, v: &SVector<f64, N>, g: &SVector<f64, N>) -> SVector<f64, N> {
+impl Nadf {
+    /// The damping force `F_d = -B_d · M(x, v)`, N, for velocity `v` (m/s) where the gradient
+    /// is `g` (eq. 10).
+    pub fn force<const N: usize>(
+        &self,
+        v: &SVector<f64, N>,
+        g: &SVector<f64, N>,
+    ) -> SVector<f64, N> {
         -Self::damped_motion(v, g) * self.b_d
+    }
+}
+
+impl<const N: usize> ControlLaw<N> for Nadf {
+    fn force(&self, input: &ControlInput<N>) -> SVector<f64, N> {
+        let g = input.gradient.unwrap_or_else(SVector::zeros);
+        Nadf::force(self, &input.velocity, &g)
     }
 }
 

@@ -3,7 +3,7 @@
 
 use nalgebra::SVector;
 
-use super::Damping;
+use super::{ControlInput, ControlLaw};
 
 /// Viscous damping.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -13,9 +13,16 @@ pub struct Viscous {
     pub b: f64,
 }
 
-impl<const N: usize> Damping<N> for Viscous {
-    fn force(&self, v: &SVector<f64, N>, _g: &SVector<f64, N>) -> SVector<f64, N> {
+impl Viscous {
+    /// The damping force `F_d = -B · v`, N, for velocity `v` (m/s).
+    pub fn force<const N: usize>(&self, v: &SVector<f64, N>) -> SVector<f64, N> {
         -v * self.b
+    }
+}
+
+impl<const N: usize> ControlLaw<N> for Viscous {
+    fn force(&self, input: &ControlInput<N>) -> SVector<f64, N> {
+        Viscous::force(self, &input.velocity)
     }
 }
 
@@ -28,10 +35,14 @@ mod tests {
     fn viscous_damping_opposes_velocity_whatever_the_guidance() {
         let d = Viscous { b: 0.7 };
         let v = Vector2::new(1.0, -2.0);
-        assert_eq!(
-            d.force(&v, &Vector2::new(1.0, 0.0)),
-            Vector2::new(-0.7, 1.4)
-        );
-        assert_eq!(d.force(&v, &Vector2::zeros()), Vector2::new(-0.7, 1.4));
+        let input = |g| ControlInput {
+            offset: Vector2::new(1.0, 1.0),
+            velocity: v,
+            gradient: g,
+            dt: 0.01,
+        };
+        for g in [Some(Vector2::new(1.0, 0.0)), None] {
+            assert_eq!(ControlLaw::force(&d, &input(g)), Vector2::new(-0.7, 1.4));
+        }
     }
 }

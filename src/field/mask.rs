@@ -7,6 +7,19 @@ use crate::world::WallShape;
 
 /// `blocked[grid.index(i, j)]` for every cell, for a disc of `radius` metres in a box of `size`.
 pub fn rasterize(grid: &Grid, size: [f64; 2], walls: &[WallShape], radius: f64) -> Vec<bool> {
+    rasterize_sensed(grid, size, walls, radius, &[])
+}
+
+/// Like [`rasterize`], with wall `k`'s boundary moved out by `offsets[k]` metres (in where
+/// negative; missing offsets are zero): the mask of walls sensed with errors. A cell is blocked
+/// when its signed distance to a wall is below `radius + offset`.
+pub fn rasterize_sensed(
+    grid: &Grid,
+    size: [f64; 2],
+    walls: &[WallShape],
+    radius: f64,
+    offsets: &[f64],
+) -> Vec<bool> {
     let mut blocked = vec![false; grid.len()];
     for j in 0..grid.ny {
         for i in 0..grid.nx {
@@ -16,8 +29,11 @@ pub fn rasterize(grid: &Grid, size: [f64; 2], walls: &[WallShape], radius: f64) 
             }
         }
     }
-    for wall in walls {
-        // Only the cells near the wall's bounding box can be within `radius` of it.
+    for (n, wall) in walls.iter().enumerate() {
+        let offset = offsets.get(n).copied().unwrap_or(0.0);
+        let reach = radius + offset;
+        // Only the cells near the wall's bounding box can be within `reach` of it.
+        let radius = reach.max(0.0);
         let aabb = wall.shape.compute_aabb(&wall.pose);
         let lo = [
             f64::from(aabb.mins.x) - radius,
@@ -33,7 +49,11 @@ pub fn rasterize(grid: &Grid, size: [f64; 2], walls: &[WallShape], radius: f64) 
                 let k = grid.index(i, j);
                 if !blocked[k] {
                     let [x, y] = grid.center(i, j);
-                    blocked[k] = wall.distance_to_point(x, y) < radius;
+                    blocked[k] = if offset == 0.0 {
+                        wall.distance_to_point(x, y) < reach
+                    } else {
+                        wall.signed_distance_to_point(x, y) < reach
+                    };
                 }
             }
         }
@@ -45,6 +65,36 @@ pub fn rasterize(grid: &Grid, size: [f64; 2], walls: &[WallShape], radius: f64) 
 mod tests {
     use super::*;
     use crate::world::{Wall, wall_shape};
+
+    #[test]
+    fn sensed_offsets_grow_and_shrink_a_wall() {
+        let size = [4.0, 4.0];
+        let grid = Grid::covering(size, 0.05);
+        let wall = wall_shape(&Wall::Box {
+            center: [2.0, 2.0],
+            half_extents: [0.5, 0.5],
+            angle: 0.0,
+        })
+        .unwrap();
+        let count = |offset: f64| {
+            let blocked =
+                rasterize_sensed(&grid, size, std::slice::from_ref(&wall), 0.2, &[offset]);
+            // Only the cells around the wall, not the box edges.
+            (0..grid.len())
+                .filter(|&k| {
+                    let [x, y] = grid.center(k % grid.nx, k / grid.nx);
+                    blocked[k] && (x - 2.0).abs() < 1.5 && (y - 2.0).abs() < 1.5
+                })
+                .count()
+        };
+        let (exact, grown, shrunk) = (count(0.0), count(0.3), count(-0.5));
+        assert!(grown > exact && exact > shrunk, "{grown} {exact} {shrunk}");
+        // Shrunk by 0.5 with a 0.2 disc: the blocked square is 0.4 m across inside the wall.
+        assert!(
+            (shrunk as f64 * 0.05 * 0.05 - 0.16).abs() < 0.05,
+            "{shrunk}"
+        );
+    }
 
     #[test]
     fn a_disc_wall_blocks_exactly_the_cells_within_radius_plus_wall_radius() {

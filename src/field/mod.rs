@@ -99,9 +99,21 @@ pub struct FreeSpace {
 impl FreeSpace {
     /// Rasterizes the world for `agent` and checks that its start connects to its target.
     pub fn of(world: &World, agent: &Agent) -> Result<Self, FieldError> {
+        Self::sensed(world, agent, agent.start, &[])
+    }
+
+    /// Like [`FreeSpace::of`] for walls sensed with errors: wall `k` of
+    /// [`all_wall_shapes`] moved out by `offsets[k]` m (see [`mask::rasterize_sensed`]), and
+    /// `position` in place of the start.
+    pub fn sensed(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        offsets: &[f64],
+    ) -> Result<Self, FieldError> {
         let grid = Grid::anchored(world.size, world.field.cell, agent.target);
         let walls = all_wall_shapes(world);
-        let blocked = mask::rasterize(&grid, world.size, &walls, agent.radius);
+        let blocked = mask::rasterize_sensed(&grid, world.size, &walls, agent.radius, offsets);
         let target_cell = grid
             .cell_of(agent.target)
             .filter(|&(i, j)| !blocked[grid.index(i, j)])
@@ -112,7 +124,7 @@ impl FreeSpace {
         let reachable = laplace::reachable_from(&grid, &blocked, target_cell);
         // The start is connected when a cell around it is: the cells the sampler interpolates.
         let near = |c: usize, n: usize| c.saturating_sub(1)..=(c + 1).min(n - 1);
-        let start_connected = grid.cell_of(agent.start).is_some_and(|(i, j)| {
+        let start_connected = grid.cell_of(position).is_some_and(|(i, j)| {
             near(i, grid.nx).any(|a| near(j, grid.ny).any(|b| reachable[grid.index(a, b)]))
         });
         if !start_connected {
@@ -135,12 +147,37 @@ impl HarmonicField {
     pub fn solve(world: &World, agent: &Agent) -> Result<Self, FieldError> {
         let started = Instant::now();
         let space = FreeSpace::of(world, agent)?;
+        Self::solve_space(world, agent, space, None, started)
+    }
+
+    /// Solves the field of walls sensed with errors (see [`FreeSpace::sensed`]) with the agent
+    /// at `position`, warm-started from `previous` (the last field, on the same grid).
+    pub fn solve_sensed(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        offsets: &[f64],
+        previous: Option<&HarmonicField>,
+    ) -> Result<Self, FieldError> {
+        let started = Instant::now();
+        let space = FreeSpace::sensed(world, agent, position, offsets)?;
+        let warm = previous.map(|f| f.sampler.w_cells());
+        Self::solve_space(world, agent, space, warm, started)
+    }
+
+    fn solve_space(
+        world: &World,
+        agent: &Agent,
+        space: FreeSpace,
+        warm: Option<&[f64]>,
+        started: Instant,
+    ) -> Result<Self, FieldError> {
         let solution = harmonic::solve_w(
             &space.grid,
             &space.reachable,
             space.target_cell,
             world.field.tolerance,
-            None,
+            warm,
         );
         if solution.relative_residual.is_nan() || solution.relative_residual > world.field.tolerance
         {

@@ -27,19 +27,30 @@ pub fn layout(world: &World) -> Blueprint {
             .collect();
         TimeSeriesView::new(title).with_contents(contents)
     };
+    let mut views = vec![
+        series("distance to target (m)", &["distance"]).into(),
+        series("speed (m/s)", &["speed", "radial_speed"]).into(),
+        series("control force (N)", &["force", "force_x", "force_y"]).into(),
+        series("potential V", &["potential"]).into(),
+    ];
+    // The clamping, speed-limit and bias signals, when some agent has them.
+    if world
+        .agents
+        .iter()
+        .any(|a| a.controller.clamp.is_some() || a.controller.speed_limit.is_some())
+    {
+        views.push(series("limits active (0/1)", &["clamping", "speed_limited"]).into());
+    }
+    if world.agents.iter().any(|a| a.controller.bias.is_some()) {
+        views.push(series("bias β (N)", &["beta_x", "beta_y"]).into());
+    }
     Blueprint::new(
         Horizontal::new([
             Spatial2DView::new(world.name())
                 .with_origin("/")
                 .with_contents(spatial)
                 .into(),
-            Vertical::new([
-                series("distance to target (m)", &["distance"]).into(),
-                series("speed (m/s)", &["speed", "radial_speed"]).into(),
-                series("control force (N)", &["force", "force_x", "force_y"]).into(),
-                series("potential V", &["potential"]).into(),
-            ])
-            .into(),
+            Vertical::new(views).into(),
         ])
         .with_column_shares([3.0, 2.0]),
     )

@@ -8,8 +8,13 @@
 //! - `agents/NAME/field/guidance`: a sparse arrow field of the unit guidance `-∇V/|∇V|` (static).
 //! - `agents/NAME/kinematic_path`, `agents/NAME/target` (static).
 //! - `agents/NAME/body`, `…/trail`, `…/velocity`, `…/force`, `…/contacts`: per step.
-//! - `agents/NAME/events`: numerical faults as they start (text log, level WARN).
+//! - `agents/NAME/events`: numerical faults as they start (text log, level WARN), bias updates
+//!   and sensing problems (level INFO).
+//! - `agents/NAME/sensed_walls`: with a noisy sensor, the outline of the configuration-space
+//!   obstacles of each reading (the walls as the agent sensed them, grown by its radius).
 //! - `plots/NAME/{distance, speed, radial_speed, force, force_x, force_y, potential}`: scalars.
+//! - `plots/NAME/{clamping, speed_limited}` (0 or 1) and `plots/NAME/{beta_x, beta_y}` (N):
+//!   when the agent's controller has a clamp, a speed limit or a bias.
 //!
 //! Time is the `sim_time` timeline, in seconds. The world is y-up while Rerun's 2D views are
 //! y-down, so `world` and `agents` carry a static transform that flips y about the box.
@@ -187,6 +192,24 @@ impl Recorder {
                     &rerun::SeriesLines::new().with_names([label]),
                 )?;
             }
+            let c = &run.agent.controller;
+            for (series, label, present) in [
+                ("clamping", "clamping active", c.clamp.is_some()),
+                (
+                    "speed_limited",
+                    "speed limit active",
+                    c.speed_limit.is_some(),
+                ),
+                ("beta_x", "β x (N)", c.bias.is_some()),
+                ("beta_y", "β y (N)", c.bias.is_some()),
+            ] {
+                if present {
+                    rec.log_static(
+                        format!("plots/{name}/{series}"),
+                        &rerun::SeriesLines::new().with_names([label]),
+                    )?;
+                }
+            }
         }
         Ok(())
     }
@@ -243,6 +266,38 @@ impl Recorder {
                 rec.log(
                     format!("agents/{name}/events"),
                     &rerun::TextLog::new(event.as_str()).with_level(rerun::TextLogLevel::WARN),
+                )?;
+            }
+            for note in &state.notes {
+                rec.log(
+                    format!("agents/{name}/events"),
+                    &rerun::TextLog::new(note.as_str()).with_level(rerun::TextLogLevel::INFO),
+                )?;
+            }
+            if let Some(sensed) = &state.sensed_walls {
+                rec.log(
+                    format!("agents/{name}/sensed_walls"),
+                    &rerun::Points2D::new(sensed.iter().map(|p| f32x2(*p)))
+                        .with_radii([0.025])
+                        .with_colors([rerun::Color::from_unmultiplied_rgba(255, 80, 80, 160)]),
+                )?;
+            }
+            let c = &run.agent.controller;
+            let flag = |on: bool| if on { 1.0 } else { 0.0 };
+            let mut extra = Vec::new();
+            if c.clamp.is_some() {
+                extra.push(("clamping", flag(state.clamping)));
+            }
+            if c.speed_limit.is_some() {
+                extra.push(("speed_limited", flag(state.speed_limited)));
+            }
+            if let Some(beta) = state.beta {
+                extra.extend([("beta_x", beta.x), ("beta_y", beta.y)]);
+            }
+            for (series, value) in extra {
+                rec.log(
+                    format!("plots/{name}/{series}"),
+                    &rerun::Scalars::single(value),
                 )?;
             }
             trail.push(p);

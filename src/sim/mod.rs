@@ -8,6 +8,7 @@
 
 pub mod faults;
 mod physics;
+mod sensor;
 
 use std::collections::HashSet;
 
@@ -16,8 +17,9 @@ use parry2d::math::Vector;
 use rapier2d::prelude::{ColliderHandle, PhysicsWorld, RigidBodyHandle};
 
 pub use physics::{from_rapier, to_rapier};
+pub use sensor::Sensor;
 
-use crate::control::{Controller, unit};
+use crate::control::{ControlInput, Controller, unit};
 use crate::field::{FieldError, HarmonicField, Streamline};
 use crate::metrics::{Metrics, Summary};
 use crate::world::{Agent, WallShape, World, all_wall_shapes};
@@ -32,8 +34,10 @@ pub const CONTACT_TOLERANCE: f64 = 1e-3;
 pub struct AgentRun {
     /// The agent as the world file describes it.
     pub agent: Agent,
-    /// Its harmonic field.
+    /// Its harmonic field: of the true walls, or of the last sensed walls with a sensor.
     pub field: HarmonicField,
+    /// Its wall sensor, if it senses the walls with noise.
+    pub sensor: Option<Sensor>,
     /// Its kinematic path (the streamline from its start).
     pub kinematic: Streamline,
     /// Its controller.
@@ -46,6 +50,7 @@ pub struct AgentRun {
     collider: ColliderHandle,
     touching: HashSet<ColliderHandle>,
     frozen: bool,
+    sensing_failed: bool,
 }
 
 /// What happened to one agent in the last step, for recording.
@@ -68,8 +73,19 @@ pub struct AgentState {
     pub clearance: f64,
     /// Points where the agent touches something, m.
     pub contact_points: Vec<Vector2<f64>>,
+    /// Whether the clamping control acted in this step.
+    pub clamping: bool,
+    /// Whether the speed limit acted in this step.
+    pub speed_limited: bool,
+    /// The bias β after this step, N (with the bias option).
+    pub beta: Option<Vector2<f64>>,
+    /// The configuration-space boundary of the walls sensed in this step (the centres of
+    /// blocked cells next to free ones), m; `None` when no reading was taken.
+    pub sensed_walls: Option<Vec<[f64; 2]>>,
     /// Faults that started in this step, as messages.
     pub events: Vec<String>,
+    /// Control events of this step (bias updates, sensing), as messages.
+    pub notes: Vec<String>,
 }
 
 /// A running simulation.
@@ -88,25 +104,33 @@ pub struct Simulation {
 impl Simulation {
     /// Builds the Rapier world and solves every agent's field.
     pub fn new(world: &World) -> Result<Self, FieldError> {
-        let mut physics = physics::empty_world(world.dt);
+        let mut physics = physics::empty_world(world.dt, world.external_acceleration);
         let walls = all_wall_shapes(world);
         physics::insert_walls(&mut physics, &walls);
         let mut agents = Vec::with_capacity(world.agents.len());
-        for agent in &world.agents {
+        for (index, agent) in world.agents.iter().enumerate() {
             let field = HarmonicField::solve(world, agent)?;
             let kinematic = field.streamline(agent.start);
             let (body, collider) = physics::insert_agent(&mut physics, agent);
             agents.push(AgentRun {
-                controller: Controller::from_settings(&agent.controller, world.field.guidance),
+                controller: Controller::from_settings(
+                    &agent.controller,
+                    world.field.guidance,
+                    agent.mass,
+                ),
                 metrics: Metrics::new(&agent.name, agent.start, agent.target),
                 agent: agent.clone(),
                 field,
+                sensor: agent
+                    .sensor
+                    .map(|settings| Sensor::new(settings, world.seed, index)),
                 kinematic,
                 faults: FaultMonitor::default(),
                 body,
                 collider,
                 touching: HashSet::new(),
                 frozen: false,
+                sensing_failed: false,
             });
         }
         Ok(Self {
@@ -131,38 +155,96 @@ impl Simulation {
 
     /// Advances one physics step and returns each agent's state after it.
     pub fn step(&mut self) -> Vec<AgentState> {
-        let mut forces = Vec::with_capacity(self.agents.len());
+        let mut controls = Vec::with_capacity(self.agents.len());
         let mut events: Vec<Vec<String>> = vec![Vec::new(); self.agents.len()];
-        for (run, events) in self.agents.iter_mut().zip(&mut events) {
+        let mut notes: Vec<Vec<String>> = vec![Vec::new(); self.agents.len()];
+        let mut sensed: Vec<Option<Vec<[f64; 2]>>> = vec![None; self.agents.len()];
+        for (((run, events), notes), sensed) in self
+            .agents
+            .iter_mut()
+            .zip(&mut events)
+            .zip(&mut notes)
+            .zip(&mut sensed)
+        {
             let body = &mut self.physics.bodies[run.body];
             let x = from_rapier(body.translation());
             let v = from_rapier(body.linvel());
-            let mut force = Vector2::zeros();
+            let mut control = None;
             if !run.frozen && !(x.iter().chain(v.iter()).all(|c| c.is_finite())) {
                 run.frozen = true;
                 events.extend(run.faults.non_finite_state());
             }
             if !run.frozen {
-                let distance = (x - Vector2::from(run.agent.target)).norm();
-                let g = run.field.gradient(x.into());
-                force = run.controller.force(distance, &v, g.as_ref());
+                if let Some(sensor) = &mut run.sensor
+                    && sensor.due(self.time)
+                {
+                    let offsets = sensor.read(self.walls.len());
+                    match HarmonicField::solve_sensed(
+                        &self.world,
+                        &run.agent,
+                        x.into(),
+                        &offsets,
+                        Some(&run.field),
+                    ) {
+                        Ok(field) => {
+                            run.field = field;
+                            run.sensing_failed = false;
+                            *sensed = Some(boundary(&run.field));
+                        }
+                        Err(e) => {
+                            if !run.sensing_failed {
+                                notes.push(format!(
+                                    "the sensed walls give no usable field ({e}); keeping the last one"
+                                ));
+                            }
+                            run.sensing_failed = true;
+                        }
+                    }
+                }
+                let input = ControlInput {
+                    offset: x - Vector2::from(run.agent.target),
+                    velocity: v,
+                    gradient: run.field.gradient(x.into()),
+                    dt: self.world.dt,
+                };
+                let mut out = run.controller.step(&input);
                 // Finite in f64 but beyond f32's range is still not finite for Rapier.
-                if !to_rapier(force).is_finite() {
-                    force = Vector2::zeros();
+                if !to_rapier(out.force).is_finite() {
+                    out.force = Vector2::zeros();
                     events.extend(run.faults.rejected_force());
                 }
+                if out.bias_updated
+                    && let Some(beta) = run.controller.beta()
+                {
+                    notes.push(format!(
+                        "settling instant at distance {:.4} m: β ← u = [{:.4}, {:.4}] N (update {})",
+                        input.offset.norm(),
+                        beta.x,
+                        beta.y,
+                        run.controller.bias.as_ref().map_or(0, |b| b.updates())
+                    ));
+                }
+                control = Some(out);
             }
+            let force = control.map_or(Vector2::zeros(), |c| c.force);
             body.reset_forces(false);
             body.add_force(to_rapier(force), true);
             run.metrics.record_force(force);
-            forces.push(force);
+            controls.push(control);
         }
         self.physics.step();
         self.steps += 1;
         self.time = self.steps as f64 * self.world.dt;
 
         let mut states = Vec::with_capacity(self.agents.len());
-        for ((run, force), mut events) in self.agents.iter_mut().zip(forces).zip(events) {
+        for ((((run, control), mut events), notes), sensed_walls) in self
+            .agents
+            .iter_mut()
+            .zip(controls)
+            .zip(events)
+            .zip(notes)
+            .zip(sensed)
+        {
             let body = &self.physics.bodies[run.body];
             let (mut position, mut velocity) =
                 (from_rapier(body.translation()), from_rapier(body.linvel()));
@@ -228,13 +310,18 @@ impl Simulation {
             states.push(AgentState {
                 position,
                 velocity,
-                force,
+                force: control.map_or(Vector2::zeros(), |c| c.force),
                 distance,
                 radial_speed,
                 potential: run.field.potential(p),
                 clearance,
                 contact_points,
+                clamping: control.is_some_and(|c| c.clamping),
+                speed_limited: control.is_some_and(|c| c.speed_limited),
+                beta: run.controller.beta(),
+                sensed_walls,
                 events,
+                notes,
             });
         }
         states
@@ -247,6 +334,30 @@ impl Simulation {
             .map(|a| a.metrics.summary(&a.kinematic, &a.faults.faults))
             .collect()
     }
+}
+
+/// The centres of the blocked cells of `field`'s mask that have a free 4-neighbour: the outline
+/// of the configuration-space obstacles the field was solved for.
+fn boundary(field: &HarmonicField) -> Vec<[f64; 2]> {
+    let grid = field.grid();
+    let blocked = &field.blocked;
+    let mut points = Vec::new();
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            if !blocked[grid.index(i, j)] {
+                continue;
+            }
+            let free = |a: usize, b: usize| !blocked[grid.index(a, b)];
+            if (i > 0 && free(i - 1, j))
+                || (i + 1 < grid.nx && free(i + 1, j))
+                || (j > 0 && free(i, j - 1))
+                || (j + 1 < grid.ny && free(i, j + 1))
+            {
+                points.push(grid.center(i, j));
+            }
+        }
+    }
+    points
 }
 
 /// Signed distance from a disc of `radius` at `position` to the nearest wall, m: positive when

@@ -16,10 +16,14 @@ pub fn to_rapier(v: Vector2<f64>) -> Vector {
     Vector::new(v.x as f32, v.y as f32)
 }
 
-/// A Rapier world with no gravity and the given step.
-pub fn empty_world(dt: f64) -> PhysicsWorld {
+/// A Rapier world with the given step whose gravity is the world's external acceleration, m/s²
+/// (Rapier applies `m·a` to every dynamic body).
+pub fn empty_world(dt: f64, external_acceleration: [f64; 2]) -> PhysicsWorld {
     PhysicsWorld {
-        gravity: Vector::ZERO,
+        gravity: Vector::new(
+            external_acceleration[0] as f32,
+            external_acceleration[1] as f32,
+        ),
         integration_parameters: IntegrationParameters {
             dt: dt as f32,
             ..IntegrationParameters::default()

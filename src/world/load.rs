@@ -16,7 +16,7 @@ use toml_edit::{DocumentMut, Item, TableLike, Value};
 use super::error::{WorldError, WorldErrors, line_column};
 use super::schema::World;
 use super::suggest::with_suggestion;
-use super::validate::validate;
+use super::validate::{validate, warnings as unlocated_warnings};
 
 /// One `--set KEY=VALUE` override: a dotted path (array items by index) and a TOML value.
 #[derive(Debug, Clone, PartialEq)]
@@ -124,6 +124,22 @@ pub fn load_str(text: &str, file: &Path, overrides: &[Override]) -> Result<World
                 .collect(),
         )
     })
+}
+
+/// The warnings about a loaded world (see [`super::validate::warnings`]), located in its file
+/// by key. They never stop a run; `nadf check` and `nadf run` print them.
+pub fn warnings(path: &Path, world: &World) -> Vec<WorldError> {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let spans = Spans::of(&text);
+    unlocated_warnings(world)
+        .into_iter()
+        .map(|(key, message)| WorldError {
+            file: path.to_path_buf(),
+            location: spans.span_of(&key).map(|s| line_column(&text, s.start)),
+            key: Some(key),
+            message,
+        })
+        .collect()
 }
 
 /// A problem found while parsing or validating, located by span in the text that was parsed.

@@ -11,13 +11,16 @@ mod suggest;
 mod validate;
 
 pub use error::{WorldError, WorldErrors};
-pub use load::{Override, load, load_str};
+pub use load::{Override, load, load_str, warnings};
 pub use schema::{
-    Agent, ControllerKind, ControllerSettings, Expect, FieldSettings, GuidanceKind,
-    OUTER_WALL_THICKNESS, Wall, World,
+    Agent, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K, Expect,
+    FieldSettings, GuidanceKind, OUTER_WALL_THICKNESS, SensorSettings, Wall, World,
 };
 pub use shapes::{WallShape, all_wall_shapes, all_walls, outer_walls, wall_shape};
 pub use validate::{MAX_CELLS, validate};
+
+/// The unlocated form of [`warnings`], for a world built in code.
+pub use validate::warnings as settings_warnings;
 
 impl World {
     /// The world's name (the file stem unless the file sets one).

@@ -26,6 +26,11 @@ pub struct World {
     /// Seed for everything random in a run (a run is deterministic for a given file and seed).
     #[serde(default)]
     pub seed: u64,
+    /// A constant external acceleration on every agent, m/s² (the paper's drift, eq. 71:
+    /// `[-4, -4]`; or gravity). Rapier applies it as gravity, `m·a` on each body. The
+    /// controllers do not know it.
+    #[serde(default)]
+    pub external_acceleration: [f64; 2],
     /// How the guidance field is built.
     #[serde(default)]
     pub field: FieldSettings,
@@ -166,6 +171,9 @@ pub struct Agent {
     pub mass: f64,
     /// The control law.
     pub controller: ControllerSettings,
+    /// Noisy sensing of the walls (default: the agent knows the walls exactly).
+    #[serde(default)]
+    pub sensor: Option<SensorSettings>,
     /// What this agent's run must show, on top of the world's `[expect]`.
     #[serde(default)]
     pub expect: Option<Expect>,
@@ -175,26 +183,103 @@ pub struct Agent {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ControllerSettings {
-    /// Which damping law turns the guidance into a control force.
+    /// Which law turns the guidance into a control force.
     pub kind: ControllerKind,
-    /// Guidance gain K: N for `normalized` guidance, N·m for `gradient` guidance.
-    #[serde(default = "default_k")]
-    pub k: f64,
-    /// Damping coefficient, N·s/m: `B_d` for NADF, `B` for viscous damping.
-    pub b: f64,
-    /// Radius around the target inside which normalized guidance tapers linearly to zero, m.
+    /// Guidance gain K: N for `normalized` guidance, N·m for `gradient` guidance
+    /// (`nadf` and `viscous`; default [`DEFAULT_K`]).
+    #[serde(default)]
+    pub k: Option<f64>,
+    /// Damping coefficient, N·s/m: `B_d` for NADF, `B` for viscous damping (required by both).
+    #[serde(default)]
+    pub b: Option<f64>,
+    /// Radius around the target inside which normalized guidance (and the sliding-mode
+    /// desired speed) tapers linearly to zero, m.
     #[serde(default = "default_capture_radius")]
     pub capture_radius: f64,
+    /// Sliding mode: the desired speed `v_d` along the guidance, m/s (eq. 72; required).
+    #[serde(default)]
+    pub vd: Option<f64>,
+    /// Sliding mode: the control magnitude `F_0`, N (eq. 73; required).
+    #[serde(default)]
+    pub f0: Option<f64>,
+    /// Speed limit `v_max`, m/s: at or above it, the part of the control force that would
+    /// accelerate the body further along its velocity is dropped (paper §VI.2).
+    #[serde(default)]
+    pub speed_limit: Option<f64>,
+    /// Clamping control near the target (eq. 35–36).
+    #[serde(default)]
+    pub clamp: Option<ClampSettings>,
+    /// Iterative blind error cancellation (eq. 48–50).
+    #[serde(default)]
+    pub bias: Option<BiasSettings>,
 }
 
-/// The damping laws.
+/// The guidance gain used when `k` is not given.
+pub const DEFAULT_K: f64 = 1.0;
+
+impl ControllerSettings {
+    /// The guidance gain K ([`DEFAULT_K`] unless given).
+    pub fn k(&self) -> f64 {
+        self.k.unwrap_or(DEFAULT_K)
+    }
+}
+
+/// The `[agents.controller.clamp]` table: `-K_c (x - x_T)` while within `sigma` of the target
+/// and moving away from it (eq. 35).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClampSettings {
+    /// Clamping gain K_c, N/m.
+    pub kc: f64,
+    /// Radius σ of the clamping region around the target, m.
+    pub sigma: f64,
+}
+
+/// The `[agents.controller.bias]` table: a bias β added to the control and reset to the
+/// control measured at each settling instant (eq. 48–50).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BiasSettings {
+    /// Settling threshold α, m/s: the body is settling while its speed is below α.
+    pub alpha: f64,
+    /// How long the speed must stay below α before β is updated, s.
+    #[serde(default = "default_dwell")]
+    pub dwell: f64,
+}
+
+/// The `[agents.sensor]` table: the agent senses the walls with noise and rebuilds its field
+/// from what it sensed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorSettings {
+    /// Half-width of the uniform noise on each wall's sensed position, m: every reading moves
+    /// each wall's boundary out or in by an independent draw from `[-noise, noise]`.
+    pub noise: f64,
+    /// Readings per second; the field is rebuilt from each reading, Hz.
+    pub rate: f64,
+}
+
+/// The control laws.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ControllerKind {
-    /// Nonlinear anisotropic damping (eq. 9–10).
+    /// Guidance plus nonlinear anisotropic damping (eq. 9–10).
     Nadf,
-    /// Linear viscous damping (eq. 1).
+    /// Guidance plus linear viscous damping (eq. 1).
     Viscous,
+    /// Guldner and Utkin's sliding mode on the guidance (eq. 72–73).
+    SlidingMode,
+}
+
+impl ControllerKind {
+    /// The name used in world files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Nadf => "nadf",
+            Self::Viscous => "viscous",
+            Self::SlidingMode => "sliding-mode",
+        }
+    }
 }
 
 fn default_true() -> bool {
@@ -221,8 +306,8 @@ fn default_radius() -> f64 {
 fn default_mass() -> f64 {
     1.0
 }
-fn default_k() -> f64 {
-    1.0
+fn default_dwell() -> f64 {
+    0.5
 }
 fn default_capture_radius() -> f64 {
     0.25

@@ -24,6 +24,15 @@ impl WallShape {
                 .distance_to_point(&self.pose, Vector::new(x as f32, y as f32), true),
         )
     }
+
+    /// Signed distance from `(x, y)` to the wall's boundary, m: positive outside, negative
+    /// inside by the depth.
+    pub fn signed_distance_to_point(&self, x: f64, y: f64) -> f64 {
+        let p = Vector::new(x as f32, y as f32);
+        let projection = self.shape.project_point(&self.pose, p, false);
+        let d = f64::from((projection.point - p).length());
+        if projection.is_inside { -d } else { d }
+    }
 }
 
 /// Converts one wall entry into a shape; `None` when parry cannot build it (a degenerate polygon).

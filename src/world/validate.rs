@@ -2,7 +2,7 @@
 //! agents that start in free space. Each problem is a dotted key path and a message; the loader
 //! turns the path into a line of the file.
 
-use super::schema::{Agent, Expect, Wall, World};
+use super::schema::{Agent, ControllerKind, ControllerSettings, Expect, GuidanceKind, Wall, World};
 use super::shapes::{outer_walls, wall_shape};
 
 /// The default of `field.max_cells`, the largest grid accepted (4096 × 4096 cells, about 640 MB
@@ -20,6 +20,11 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
     positive(&mut bad, "dt", world.dt);
     positive(&mut bad, "duration", world.duration);
     positive(&mut bad, "field.cell", world.field.cell);
+    finite_point(
+        &mut bad,
+        "external_acceleration",
+        world.external_acceleration,
+    );
     if !(world.field.tolerance > 0.0 && world.field.tolerance < 1.0) {
         bad(
             "field.tolerance".into(),
@@ -78,12 +83,130 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
     issues
 }
 
+/// Settings that are valid but will not work as intended, as `(key path, message)`: so far,
+/// condition 40 of Proposition 3 (the guidance must beat the external force outside the
+/// clamping region, or the body may never reach the target).
+///
+/// With normalized guidance the thrust outside σ is at least `K·min(1, σ/r_c)` (σ is the clamp's
+/// radius, or `r_c` without a clamp), and the external force along the guidance is at most
+/// `m·|a|`; the warning fires when the first does not exceed the second. Gradient guidance
+/// needs the solved field to check, so it is not checked here. Sliding mode needs `F_0 > m·|a|`.
+pub fn warnings(world: &World) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let [ax, ay] = world.external_acceleration;
+    let a = ax.hypot(ay);
+    if !(a.is_finite() && a > 0.0) {
+        return out;
+    }
+    for (i, agent) in world.agents.iter().enumerate() {
+        let c = &agent.controller;
+        let external = agent.mass * a;
+        match c.kind {
+            ControllerKind::Nadf | ControllerKind::Viscous => {
+                if world.field.guidance != GuidanceKind::Normalized {
+                    continue;
+                }
+                let sigma = c.clamp.map_or(c.capture_radius, |clamp| clamp.sigma);
+                let taper = if c.capture_radius > 0.0 {
+                    (sigma / c.capture_radius).min(1.0)
+                } else {
+                    1.0
+                };
+                let thrust = c.k() * taper;
+                if thrust <= external {
+                    out.push((
+                        format!("agents.{i}.controller.k"),
+                        format!(
+                            "condition 40 may fail: outside {sigma} m of the target the guidance pushes with as little as K·min(1, σ/r_c) = {thrust:.3} N, not more than the external force m·|a| = {external:.3} N; the body may stall or drift away before reaching the target (raise k above {:.3} N, or the clamp's sigma)",
+                            external / taper
+                        ),
+                    ));
+                }
+            }
+            ControllerKind::SlidingMode => {
+                let f0 = c.f0.unwrap_or(0.0);
+                if f0 <= external {
+                    out.push((
+                        format!("agents.{i}.controller.f0"),
+                        format!(
+                            "F_0 = {f0} N does not exceed the external force m·|a| = {external:.3} N: the sliding mode cannot reach its surface"
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    out
+}
+
 fn positive(bad: &mut impl FnMut(String, String), key: &str, x: f64) {
     if !(x.is_finite() && x > 0.0) {
         bad(
             key.into(),
             format!("must be a positive finite number, got {x}"),
         );
+    }
+}
+
+fn non_negative(bad: &mut impl FnMut(String, String), key: &str, x: f64) {
+    if !(x.is_finite() && x >= 0.0) {
+        bad(key.into(), format!("must be a finite number ≥ 0, got {x}"));
+    }
+}
+
+/// The parameters each kind of controller needs, and no others.
+fn check_controller(
+    bad: &mut impl FnMut(String, String),
+    key: &dyn Fn(&str) -> String,
+    c: &ControllerSettings,
+) {
+    let kind = c.kind.name();
+    let needs =
+        |bad: &mut dyn FnMut(String, String), name: &str, value: Option<f64>, what: &str| {
+            if value.is_none() {
+                bad(
+                    key(name),
+                    format!("kind = \"{kind}\" needs `{name}` ({what})"),
+                );
+            }
+        };
+    let unused = |bad: &mut dyn FnMut(String, String), name: &str, value: Option<f64>| {
+        if value.is_some() {
+            bad(key(name), format!("is not used by kind = \"{kind}\""));
+        }
+    };
+    match c.kind {
+        ControllerKind::Nadf | ControllerKind::Viscous => {
+            needs(&mut *bad, "b", c.b, "the damping coefficient, N·s/m");
+            unused(&mut *bad, "vd", c.vd);
+            unused(&mut *bad, "f0", c.f0);
+        }
+        ControllerKind::SlidingMode => {
+            needs(&mut *bad, "vd", c.vd, "the desired speed, m/s");
+            needs(&mut *bad, "f0", c.f0, "the control magnitude, N");
+            unused(&mut *bad, "k", c.k);
+            unused(&mut *bad, "b", c.b);
+        }
+    }
+    if let Some(k) = c.k {
+        positive(bad, &key("k"), k);
+    }
+    if let Some(b) = c.b {
+        non_negative(bad, &key("b"), b);
+    }
+    for (name, value) in [("vd", c.vd), ("f0", c.f0), ("speed_limit", c.speed_limit)] {
+        if let Some(x) = value {
+            positive(bad, &key(name), x);
+        }
+    }
+    non_negative(bad, &key("capture_radius"), c.capture_radius);
+    if let Some(clamp) = &c.clamp {
+        positive(bad, &key("clamp.kc"), clamp.kc);
+        positive(bad, &key("clamp.sigma"), clamp.sigma);
+    }
+    if let Some(bias) = &c.bias {
+        positive(bad, &key("bias.alpha"), bias.alpha);
+        non_negative(bad, &key("bias.dwell"), bias.dwell);
     }
 }
 
@@ -218,19 +341,24 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
     }
     positive(bad, &key("radius"), agent.radius);
     positive(bad, &key("mass"), agent.mass);
-    let c = &agent.controller;
-    positive(bad, &key("controller.k"), c.k);
-    if !(c.b.is_finite() && c.b >= 0.0) {
-        bad(
-            key("controller.b"),
-            format!("must be a finite number ≥ 0, got {}", c.b),
-        );
-    }
-    if !(c.capture_radius.is_finite() && c.capture_radius >= 0.0) {
-        bad(
-            key("controller.capture_radius"),
-            format!("must be a finite number ≥ 0, got {}", c.capture_radius),
-        );
+    check_controller(bad, &|k| key(&format!("controller.{k}")), &agent.controller);
+    if let Some(sensor) = &agent.sensor {
+        non_negative(bad, &key("sensor.noise"), sensor.noise);
+        positive(bad, &key("sensor.rate"), sensor.rate);
+        if sensor.rate.is_finite()
+            && world.dt.is_finite()
+            && world.dt > 0.0
+            && sensor.rate * world.dt > 1.0 + 1e-9
+        {
+            bad(
+                key("sensor.rate"),
+                format!(
+                    "{} Hz is faster than the physics step ({} Hz): at most one reading per step",
+                    sensor.rate,
+                    1.0 / world.dt
+                ),
+            );
+        }
     }
     let start_ok = finite_point(bad, &key("start"), agent.start);
     let target_ok = finite_point(bad, &key("target"), agent.target);

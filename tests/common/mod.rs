@@ -40,3 +40,22 @@ pub fn assert_success(out: &std::process::Output) {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// Runs a world already loaded (and perhaps edited) and returns its first agent's summary.
+pub fn summary_of(world: &World) -> Summary {
+    let report = run(world, &RunOptions::default()).unwrap();
+    report.agents.into_iter().next().unwrap()
+}
+
+/// Runs a world step by step and returns its first agent's state after every step, with the
+/// time, and the final summary.
+pub fn trace(world: &World) -> (Vec<(f64, nadf::sim::AgentState)>, Summary) {
+    let mut sim = nadf::sim::Simulation::new(world).unwrap();
+    let mut states = Vec::with_capacity(world.steps());
+    while !sim.finished() {
+        let state = sim.step().into_iter().next().unwrap();
+        states.push((sim.time(), state));
+    }
+    let summary = sim.summaries().into_iter().next().unwrap();
+    (states, summary)
+}

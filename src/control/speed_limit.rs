@@ -1,0 +1,128 @@
+//! The speed limit of paper §VI.2 (design page, "Speed limit"): at or above `v_max`, the part of
+//! the control force that would accelerate the body further along its velocity is dropped.
+//!
+//! NADF leaves motion along the guidance undamped, so a body on a long streamline keeps
+//! speeding up; the limit caps the radial speed at `v_max` at the cost of a longer settling time
+//! and buys a lower control effort (paper figures 19–22: 12 s → 16 s).
+//!
+//! In continuous time only the part of the force along `v` changes the speed. In a discrete step
+//! the sideways part `F_⊥` also lengthens the velocity, by about `(F_⊥ dt/m)² / 2|v|`; in a
+//! long turn at the limit that adds up (measured on the room world with K = 5: 5.16 m/s against
+//! a 5 m/s limit). At the limit the along part is therefore set to the small braking force that
+//! keeps the speed exactly where it is over the step, and the body never exceeds `v_max` by
+//! more than the one step of acceleration that crosses it.
+//!
+//! A force the controller does not know about (an external drift along the motion) can still
+//! push the body past the limit. Above `v_max` the limiter therefore also brakes by the excess,
+//! `m (|v| - v_max)/dt` (back to the limit in one step): feedback on the measured speed, which
+//! needs no model of the external force. Without external forces the body is never above the
+//! limit by more than one step's control acceleration, and this term stays that small.
+
+use nalgebra::SVector;
+
+/// A cap on the speed the controller drives the body to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeedLimit {
+    /// The limit `v_max`, m/s (the paper uses 5 m/s). The body can overshoot it by at most one
+    /// step's acceleration, `|F|/m · dt`.
+    pub v_max: f64,
+    /// The body's mass, kg (to keep the speed constant over a discrete step).
+    pub mass: f64,
+}
+
+impl SpeedLimit {
+    /// The force `force` (N) applied over a step of `dt` (s) with its accelerating part along
+    /// `v` removed when `|v| ≥ v_max`, and whether the limit acted. Braking and steering parts
+    /// are kept.
+    pub fn limit<const N: usize>(
+        &self,
+        force: SVector<f64, N>,
+        v: &SVector<f64, N>,
+        dt: f64,
+    ) -> (SVector<f64, N>, bool) {
+        let speed = v.norm();
+        if !(speed >= self.v_max && speed > 0.0) {
+            return (force, false);
+        }
+        let heading = v / speed;
+        let along = heading.dot(&force);
+        let sideways = force - heading * along;
+        // The along part that keeps |v + F dt/m| = |v| (zero in continuous time).
+        let turn = sideways.norm() * dt / self.mass;
+        let hold = if turn < speed {
+            self.mass / dt * ((speed * speed - turn * turn).sqrt() - speed)
+        } else {
+            -self.mass / dt * speed
+        } - self.mass / dt * (speed - self.v_max);
+        if along > hold {
+            (sideways + heading * hold, true)
+        } else {
+            (force, false)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector2;
+
+    const LIMIT: SpeedLimit = SpeedLimit {
+        v_max: 5.0,
+        mass: 2.0,
+    };
+
+    #[test]
+    fn below_the_limit_nothing_changes() {
+        let f = Vector2::new(3.0, 1.0);
+        assert_eq!(LIMIT.limit(f, &Vector2::new(4.9, 0.0), 0.01), (f, false));
+    }
+
+    #[test]
+    fn at_the_limit_the_accelerating_part_is_dropped_and_the_speed_holds() {
+        let dt = 0.01;
+        let v = Vector2::new(5.0, 0.0);
+        let (f, active) = LIMIT.limit(Vector2::new(3.0, 40.0), &v, dt);
+        assert!(active);
+        // Steering is kept; the along part is a tiny brake (zero as dt → 0).
+        assert_eq!(f.y, 40.0);
+        assert!(f.x < 0.0 && f.x > -1.0, "{f}");
+        let next = v + f * dt / LIMIT.mass;
+        assert!((next.norm() - 5.0).abs() < 1e-12, "{}", next.norm());
+        // Above the limit (pushed by a force the controller does not know): back to it in a step.
+        let v = Vector2::new(5.2, 0.0);
+        let (f, active) = LIMIT.limit(Vector2::new(3.0, 0.0), &v, dt);
+        assert!(active);
+        assert!(((v + f * dt / LIMIT.mass).norm() - 5.0).abs() < 1e-12);
+        // Braking harder than the limit needs is kept.
+        let (f, active) = LIMIT.limit(Vector2::new(-3.0, 1.0), &Vector2::new(5.0, 0.0), dt);
+        assert!(!active);
+        assert_eq!(f, Vector2::new(-3.0, 1.0));
+    }
+
+    #[test]
+    fn an_unknown_drift_along_the_motion_is_braked() {
+        let (dt, mut v) = (0.01, Vector2::new(4.0, 0.0));
+        let drift = Vector2::new(8.0, 0.0);
+        let mut peak: f64 = 0.0;
+        for _ in 0..1000 {
+            let (f, _) = LIMIT.limit(Vector2::new(6.0, 0.0), &v, dt);
+            v += (f + drift) * dt / LIMIT.mass;
+            peak = peak.max(v.norm());
+        }
+        // One step of the drift's and the control's acceleration at most: (8 + 6)/2 · 0.01.
+        assert!(peak <= 5.0 + 0.07 + 1e-12, "{peak}");
+    }
+
+    #[test]
+    fn a_long_turn_at_the_limit_does_not_creep_above_it() {
+        // A body pushed sideways every step (a turn) with a forward push too.
+        let (dt, mut v) = (0.01, Vector2::new(5.0, 0.0));
+        for _ in 0..1000 {
+            let normal = Vector2::new(-v.y, v.x).normalize();
+            let (f, _) = LIMIT.limit(normal * 60.0 + v.normalize() * 10.0, &v, dt);
+            v += f * dt / LIMIT.mass;
+        }
+        assert!((v.norm() - 5.0).abs() < 1e-9, "{}", v.norm());
+    }
+}
