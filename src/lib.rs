@@ -21,4 +21,5 @@ pub mod metrics;
 pub mod record;
 pub mod run;
 pub mod sim;
+pub mod sweep;
 pub mod world;

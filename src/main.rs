@@ -71,6 +71,31 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         overrides: Vec<Override>,
     },
+    /// Run a world for every combination of swept values, in parallel, and write `sweep.csv`
+    /// (every summary metric per run and agent) and `sweep.png` (settling time, δ_m and
+    /// contacts against the first swept value).
+    Sweep {
+        /// The world file (TOML).
+        world: PathBuf,
+        /// A swept value: COUNT evenly spaced values from START to END, both included
+        /// (e.g. --set-range agents.0.controller.b=0.1:3.0:30). Repeatable: the runs are the
+        /// Cartesian product, plotted against the first.
+        #[arg(
+            long = "set-range",
+            value_name = "KEY=START:END:COUNT",
+            required = true
+        )]
+        ranges: Vec<nadf::sweep::Range>,
+        /// Override a world value for every run (see `run`). Repeatable.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<Override>,
+        /// The directory to write into [default: WORLD_STEM-sweep].
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Threads to run on [default: one per core].
+        #[arg(long, short = 'j', value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+        jobs: Option<u16>,
+    },
     /// Validate world files and print every problem found (file, line, key).
     Check {
         /// The world files.
@@ -89,6 +114,13 @@ fn main() -> ExitCode {
             overrides,
         } => run_command(&world, output, no_record, json, &overrides),
         Command::Check { worlds } => check_command(&worlds),
+        Command::Sweep {
+            world,
+            ranges,
+            overrides,
+            out,
+            jobs,
+        } => sweep_command(&world, &ranges, &overrides, out, jobs.map(usize::from)),
         Command::Field {
             world,
             agent,
@@ -277,6 +309,90 @@ fn field_command(
         }
         println!("wrote {}", out.display());
     }
+    ExitCode::SUCCESS
+}
+
+fn sweep_command(
+    path: &Path,
+    ranges: &[nadf::sweep::Range],
+    overrides: &[Override],
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+) -> ExitCode {
+    use nadf::sweep::{self, SweepError};
+
+    let cases = match sweep::cases(path, ranges, overrides) {
+        Ok(cases) => cases,
+        Err(e) => {
+            eprintln!("error: {}: {e}", path.display());
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    if let Some(first) = cases.first() {
+        print_warnings(path, &first.world);
+    }
+    let keys: Vec<String> = ranges.iter().map(|r| r.path.clone()).collect();
+    let bar = if std::io::stderr().is_terminal() && std::env::var_os("CI").is_none() {
+        indicatif::ProgressBar::new(cases.len() as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})")
+            .expect("a valid template"),
+    );
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&interrupt);
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        eprintln!("warning: Ctrl-C will not stop the sweep cleanly: {e}");
+    }
+    let result = sweep::run_all(&keys, &cases, jobs, &|| bar.inc(1), Some(&interrupt));
+    bar.finish_and_clear();
+    let done = match result {
+        Ok(done) => done,
+        Err(e @ SweepError::Interrupted { .. }) => {
+            eprintln!("{e}; nothing written");
+            return ExitCode::from(INTERRUPTED);
+        }
+        Err(e @ SweepError::Run { .. }) => {
+            eprintln!("error: {}: {e}", path.display());
+            return ExitCode::from(BAD_INPUT);
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(FAILED);
+        }
+    };
+    let dir = out.unwrap_or_else(|| sweep::default_out(path));
+    let title = format!("{}: sweep of {}", cases[0].world.name(), keys.join(" × "));
+    let picture = match sweep::plot(&done, &title) {
+        Ok(png) => png,
+        Err(e) => {
+            eprintln!("error: cannot draw the sweep's plot: {e}");
+            return ExitCode::from(FAILED);
+        }
+    };
+    if let Err(e) = std::fs::create_dir_all(&dir) {
+        eprintln!("error: cannot create {}: {e}", dir.display());
+        return ExitCode::from(FAILED);
+    }
+    for (name, bytes) in [
+        ("sweep.csv", done.csv().into_bytes()),
+        ("sweep.png", picture),
+    ] {
+        let file = dir.join(name);
+        if let Err(e) = export::write(&file, &bytes) {
+            eprintln!("error: cannot write {}: {e}", file.display());
+            return ExitCode::from(FAILED);
+        }
+        println!("wrote {}", file.display());
+    }
+    println!(
+        "{} runs on {} thread(s) in {:.2} s",
+        done.runs.len(),
+        done.threads,
+        done.wall_time.as_secs_f64()
+    );
     ExitCode::SUCCESS
 }
 
