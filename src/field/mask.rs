@@ -49,6 +49,9 @@ pub fn rasterize_sensed(
                 let k = grid.index(i, j);
                 if !blocked[k] {
                     let [x, y] = grid.center(i, j);
+                    // The sensed case needs the signed distance (a thinner wall shrinks
+                    // inside); the exact case keeps parry's solid distance query, which
+                    // differs from the projection in the last f32 bits at the mask's edge.
                     blocked[k] = if offset == 0.0 {
                         wall.distance_to_point(x, y) < reach
                     } else {
