@@ -8,11 +8,13 @@
 //! - [`world`]: the world file (TOML): schema, loading with `--set` overrides, validation.
 //! - [`field`]: the configuration-space mask, the Laplace solver, gradient sampling and the
 //!   kinematic streamline.
-//! - [`control`]: guidance and the damping laws (viscous, NADF) behind one trait.
-//! - [`sim`]: the Rapier world and the step loop.
+//! - [`control`]: the control laws behind one trait: guidance, viscous, NADF, sliding mode,
+//!   clamping, the iterative bias and the speed limit.
+//! - [`sim`]: the Rapier world, the step loop and the noisy wall sensor.
 //! - [`metrics`]: what a run reports per agent; [`expect`]: checking it against `[expect]`.
 //! - [`record`]: the Rerun recording.
 //! - [`run`](mod@run): a whole headless run, as the `nadf run` command does it.
+//! - [`sweep`]: parameter sweeps in parallel, with a CSV and a plot (`nadf sweep`).
 
 pub mod control;
 pub mod expect;
