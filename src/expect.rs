@@ -60,11 +60,36 @@ pub fn check(e: &Expect, s: &Summary) -> Vec<String> {
         }
     };
     at_least("min_clearance", s.min_clearance, e.min_clearance, "m");
+    if e.min_distance_covered.is_some() || e.max_distance_covered.is_some() {
+        match s.distance_covered {
+            None => failed.push(
+                "distance_covered was not measured (set distance_at within the duration)"
+                    .to_string(),
+            ),
+            Some(d) => {
+                at_least("distance_covered", d, e.min_distance_covered, "m");
+                if let Some(b) = e.max_distance_covered
+                    && d > b
+                {
+                    failed.push(format!("distance_covered = {d:.4} m, expected ≤ {b} m"));
+                }
+            }
+        }
+    }
+    if let Some(n) = e.max_lateral_reversals
+        && s.lateral_reversals > n
+    {
+        failed.push(format!(
+            "lateral_reversals = {}, expected at most {n}",
+            s.lateral_reversals
+        ));
+    }
     for (name, value, bound, unit) in [
         ("final_error", s.final_error, e.max_final_error, "m"),
         ("max_deviation", s.max_deviation, e.max_deviation, "m"),
         ("peak_speed", s.peak_speed, e.max_peak_speed, "m/s"),
         ("peak_force", s.peak_force, e.max_peak_force, "N"),
+        ("final_speed", s.final_speed, e.max_final_speed, "m/s"),
     ] {
         if let Some(b) = bound
             && (value > b || value.is_nan())
@@ -92,6 +117,10 @@ mod tests {
             peak_force: 30.0,
             control_variation: 100.0,
             peak_speed: 4.0,
+            final_speed: 0.01,
+            distance_covered: Some(20.0),
+            lateral_speed_rms: 0.1,
+            lateral_reversals: 3,
             faults: crate::metrics::Faults::default(),
         }
     }
@@ -139,5 +168,27 @@ mod tests {
             check(&e, &s),
             ["never settled, expected settling_time ≤ 60 s"]
         );
+    }
+
+    #[test]
+    fn distance_covered_stopping_and_sideways_reversals_are_checked() {
+        let e = Expect {
+            min_distance_covered: Some(25.0),
+            max_final_speed: Some(0.001),
+            max_lateral_reversals: Some(2),
+            ..Expect::default()
+        };
+        let failed = check(&e, &summary());
+        assert_eq!(failed.len(), 3, "{failed:?}");
+        assert!(failed[0].contains("distance_covered = 20.0000 m, expected ≥ 25 m"));
+        assert!(failed[1].contains("lateral_reversals = 3"));
+        assert!(failed[2].contains("final_speed = 0.0100 m/s"));
+        let mut unmeasured = summary();
+        unmeasured.distance_covered = None;
+        let e = Expect {
+            max_distance_covered: Some(30.0),
+            ..Expect::default()
+        };
+        assert!(check(&e, &unmeasured)[0].contains("not measured"));
     }
 }

@@ -11,7 +11,7 @@ use clap::{Parser, Subcommand};
 use nadf::field::{FreeSpace, HarmonicField, export};
 use nadf::record::field_picture;
 use nadf::run::{RunError, RunOptions, run};
-use nadf::world::{Override, load};
+use nadf::world::{FieldKind, Override, load};
 
 /// Exit status for bad input (a world file, an override or an intractable task).
 const BAD_INPUT: u8 = 2;
@@ -257,6 +257,12 @@ fn field_command(
         );
         return ExitCode::from(BAD_INPUT);
     };
+    if world.field.kind != FieldKind::Harmonic {
+        eprintln!(
+            "note: {} guides its agents with field.kind = \"attractive-repulsive\"; this is the harmonic field of the same walls, for comparison",
+            path.display()
+        );
+    }
     let field = match HarmonicField::solve(&world, agent) {
         Ok(field) => field,
         Err(e) => {
@@ -408,10 +414,13 @@ fn check_command(paths: &[PathBuf]) -> ExitCode {
             }
         };
         print_warnings(path, &world);
-        // The file is well formed; is every agent's task tractable on its grid?
+        // The file is well formed; is every agent's task tractable on its grid? (An
+        // attractive-repulsive field has no grid and no such guarantee: it is the baseline.)
+        let harmonic = world.field.kind == FieldKind::Harmonic;
         let problems: Vec<String> = world
             .agents
             .iter()
+            .filter(|_| harmonic)
             .filter_map(|agent| FreeSpace::of(&world, agent).err())
             .map(|e| format!("error: {}: {e}", path.display()))
             .collect();

@@ -7,6 +7,14 @@
 //! - `min_clearance`: smallest parry distance from the agent's disc to any wall.
 //! - `max_deviation` (`δ_m`): largest distance from the dynamic path to the kinematic path.
 //! - `peak_force`, `control_variation` (`Σ|F_k − F_{k−1}|`), `peak_speed`, `path_length`.
+//! - `final_speed`: the speed at the end (a body that braked and stopped short has
+//!   `reached = false` and `final_speed` near zero).
+//! - `distance_covered`: how far the body is from its start at the world's `distance_at` time
+//!   (the paper's "25 metres in 10 seconds" along a corridor, §VI.6).
+//! - Sideways oscillation, measured across the start-to-target line (the corridor's axis):
+//!   `lateral_speed_rms`, the RMS of the velocity across that line over the run, and
+//!   `lateral_reversals`, how often the motion across it reverses between excursions faster than
+//!   [`LATERAL_REVERSAL_SPEED`] (the narrow corridor effect is a stream of such reversals).
 
 use nalgebra::Vector2;
 use serde::Serialize;
@@ -15,6 +23,10 @@ use crate::field::Streamline;
 
 /// The width of the settling band, as a fraction of the initial distance to the target.
 pub const SETTLING_BAND: f64 = 0.05;
+
+/// A reversal of the sideways motion counts only between excursions faster than this, m/s, so
+/// that the jitter of a body moving straight is not counted as oscillation.
+pub const LATERAL_REVERSAL_SPEED: f64 = 0.05;
 
 /// One agent's summary, with the key names of `--json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -41,6 +53,16 @@ pub struct Summary {
     pub control_variation: f64,
     /// Largest speed, m/s.
     pub peak_speed: f64,
+    /// Speed at the end of the run, m/s.
+    pub final_speed: f64,
+    /// Distance from the start at the world's `distance_at` time, m; `None` without
+    /// `distance_at`, or when the run ended before it.
+    pub distance_covered: Option<f64>,
+    /// RMS of the velocity across the start-to-target line over the run, m/s.
+    pub lateral_speed_rms: f64,
+    /// Reversals of the motion across the start-to-target line (between excursions faster than
+    /// [`LATERAL_REVERSAL_SPEED`]).
+    pub lateral_reversals: usize,
     /// Numerical faults met during the run (all zero in a healthy run).
     pub faults: Faults,
 }
@@ -87,13 +109,30 @@ pub struct Metrics {
     control_variation: f64,
     last_force: Option<Vector2<f64>>,
     peak_speed: f64,
+    final_speed: f64,
+    start: Vector2<f64>,
+    distance_at: Option<f64>,
+    distance_covered: Option<f64>,
+    lateral_axis: Vector2<f64>,
+    lateral_square_sum: f64,
+    states: usize,
+    lateral_sign: f64,
+    lateral_reversals: usize,
 }
 
 impl Metrics {
-    /// Starts the record of an agent at `start` heading for `target`.
-    pub fn new(name: &str, start: [f64; 2], target: [f64; 2]) -> Self {
+    /// Starts the record of an agent at `start` heading for `target`; `distance_at` is the time
+    /// (s) at which to measure the distance covered, if any.
+    pub fn new(name: &str, start: [f64; 2], target: [f64; 2], distance_at: Option<f64>) -> Self {
         let (start, target) = (Vector2::from(start), Vector2::from(target));
         let d0 = (start - target).norm();
+        // Across the start-to-target line: its normal (zero when start and target coincide).
+        let axis = target - start;
+        let lateral_axis = if d0 > 0.0 {
+            Vector2::new(-axis.y, axis.x) / d0
+        } else {
+            Vector2::zeros()
+        };
         Self {
             name: name.to_string(),
             target,
@@ -109,6 +148,15 @@ impl Metrics {
             control_variation: 0.0,
             last_force: None,
             peak_speed: 0.0,
+            final_speed: 0.0,
+            start,
+            distance_at,
+            distance_covered: (distance_at == Some(0.0)).then_some(0.0),
+            lateral_axis,
+            lateral_square_sum: 0.0,
+            states: 0,
+            lateral_sign: 0.0,
+            lateral_reversals: 0,
         }
     }
 
@@ -147,6 +195,20 @@ impl Metrics {
         self.path_length += (position - last).norm();
         self.path.push(position.into());
         self.peak_speed = self.peak_speed.max(velocity.norm());
+        self.final_speed = velocity.norm();
+        if self.distance_covered.is_none() && self.distance_at.is_some_and(|at| t + 1e-9 >= at) {
+            self.distance_covered = Some((position - self.start).norm());
+        }
+        let lateral = velocity.dot(&self.lateral_axis);
+        self.lateral_square_sum += lateral * lateral;
+        self.states += 1;
+        if lateral.abs() > LATERAL_REVERSAL_SPEED {
+            let sign = lateral.signum();
+            if self.lateral_sign != 0.0 && sign != self.lateral_sign {
+                self.lateral_reversals += 1;
+            }
+            self.lateral_sign = sign;
+        }
     }
 
     /// Counts `n` new contact starts.
@@ -183,6 +245,14 @@ impl Metrics {
             peak_force: self.peak_force,
             control_variation: self.control_variation,
             peak_speed: self.peak_speed,
+            final_speed: self.final_speed,
+            distance_covered: self.distance_covered,
+            lateral_speed_rms: if self.states > 0 {
+                (self.lateral_square_sum / self.states as f64).sqrt()
+            } else {
+                0.0
+            },
+            lateral_reversals: self.lateral_reversals,
             faults: faults.clone(),
         }
     }
@@ -201,7 +271,7 @@ mod tests {
 
     #[test]
     fn settling_time_is_the_last_entry_into_the_band() {
-        let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0]);
+        let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0], None);
         let v = Vector2::zeros();
         for (t, x) in [(1.0, 5.0), (2.0, 9.7), (3.0, 10.6), (4.0, 9.9), (5.0, 10.0)] {
             m.record_state(t, Vector2::new(x, 0.0), v, 1.0);
@@ -215,7 +285,7 @@ mod tests {
 
     #[test]
     fn an_agent_that_ends_outside_the_band_never_settled() {
-        let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0]);
+        let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0], None);
         m.record_state(1.0, Vector2::new(9.9, 0.0), Vector2::zeros(), 1.0);
         m.record_state(2.0, Vector2::new(8.0, 1.0), Vector2::new(3.0, 4.0), 0.2);
         let s = m.summary(&straight(), &Faults::default());
@@ -228,12 +298,46 @@ mod tests {
 
     #[test]
     fn control_variation_sums_force_changes() {
-        let mut m = Metrics::new("a", [0.0, 0.0], [1.0, 0.0]);
+        let mut m = Metrics::new("a", [0.0, 0.0], [1.0, 0.0], None);
         for f in [[1.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 2.0]] {
             m.record_force(Vector2::from(f));
         }
         let s = m.summary(&straight(), &Faults::default());
         assert_eq!(s.control_variation, 3.0);
         assert_eq!(s.peak_force, 2.0);
+    }
+
+    #[test]
+    fn distance_covered_is_taken_at_the_given_time() {
+        let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0], Some(2.0));
+        let v = Vector2::new(1.0, 0.0);
+        m.record_state(1.0, Vector2::new(1.0, 0.0), v, 1.0);
+        assert_eq!(
+            m.summary(&straight(), &Faults::default()).distance_covered,
+            None
+        );
+        m.record_state(2.0, Vector2::new(3.0, 4.0), v, 1.0);
+        m.record_state(3.0, Vector2::new(9.0, 0.0), Vector2::zeros(), 1.0);
+        let s = m.summary(&straight(), &Faults::default());
+        assert_eq!(s.distance_covered, Some(5.0));
+        assert_eq!(s.final_speed, 0.0);
+    }
+
+    #[test]
+    fn sideways_oscillation_counts_reversals_beyond_the_threshold() {
+        // Going along +x: sideways is y.
+        let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0], None);
+        let p = Vector2::zeros();
+        for (t, vy) in [0.3, 0.01, -0.01, -0.3, 0.02, -0.2, 0.4]
+            .into_iter()
+            .enumerate()
+        {
+            m.record_state(t as f64, p, Vector2::new(1.0, vy), 1.0);
+        }
+        let s = m.summary(&straight(), &Faults::default());
+        // +0.3 → -0.3 → (-0.2 same side) → +0.4: two reversals; the small ones do not count.
+        assert_eq!(s.lateral_reversals, 2);
+        let rms = ((0.09 + 0.0001 + 0.0001 + 0.09 + 0.0004 + 0.04 + 0.16) / 7.0f64).sqrt();
+        assert!((s.lateral_speed_rms - rms).abs() < 1e-12);
     }
 }

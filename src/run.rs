@@ -64,7 +64,7 @@ pub struct Report {
     /// The recording written, if any.
     #[serde(skip)]
     pub recording: Option<PathBuf>,
-    /// How each agent's field was solved.
+    /// How each agent's harmonic field was first solved (none for attractive-repulsive fields).
     #[serde(skip)]
     pub fields: Vec<FieldStats>,
     /// The simulated time at which the run was interrupted, if it was.
@@ -96,13 +96,16 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
     let fields = sim
         .agents
         .iter()
-        .map(|a| FieldStats {
-            agent: a.agent.name.clone(),
-            cells: [a.field.grid().nx, a.field.grid().ny],
-            iterations: a.field.iterations,
-            solves: a.field.solves,
-            relative_residual: a.field.relative_residual,
-            solve_time: a.field.solve_time,
+        .filter_map(|a| {
+            let field = a.field.harmonic()?;
+            Some(FieldStats {
+                agent: a.agent.name.clone(),
+                cells: [field.grid().nx, field.grid().ny],
+                iterations: field.iterations,
+                solves: field.solves,
+                relative_residual: field.relative_residual,
+                solve_time: field.solve_time,
+            })
         })
         .collect();
     let mut recorder = match &options.recording {

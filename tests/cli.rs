@@ -124,6 +124,10 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
         "peak_force",
         "control_variation",
         "peak_speed",
+        "final_speed",
+        "distance_covered",
+        "lateral_speed_rms",
+        "lateral_reversals",
         "faults",
     ]
     .into();

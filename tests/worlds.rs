@@ -55,8 +55,12 @@ fn every_shipped_world_meets_its_expectations() {
                 "left_box_steps",
             ] {
                 // A field rebuilt from noisy sensing can put a sensed wall over the body for a
-                // step: its guidance is then undefined, as a real robot's would be.
-                if key == "guidance_lost_steps" && settings.sensor.is_some() {
+                // step: its guidance is then undefined, as a real robot's would be. Khatib's
+                // potential has local minima (the barrier): a body resting in one has none.
+                if key == "guidance_lost_steps"
+                    && (settings.sensor.is_some()
+                        || world.field.kind == nadf::world::FieldKind::AttractiveRepulsive)
+                {
                     continue;
                 }
                 assert_eq!(faults[key], 0, "{}: {faults}", path.display());

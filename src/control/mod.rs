@@ -90,6 +90,8 @@ pub struct Controller<const N: usize> {
     pub bias: Option<Bias<N>>,
     /// The speed limit, if any.
     pub speed_limit: Option<SpeedLimit>,
+    /// Actuator saturation `F_max`, N (typical: a few times the guidance gain), if any.
+    pub max_force: Option<f64>,
 }
 
 impl<const N: usize> Controller<N> {
@@ -100,6 +102,7 @@ impl<const N: usize> Controller<N> {
             clamp: None,
             bias: None,
             speed_limit: None,
+            max_force: None,
         }
     }
 
@@ -113,6 +116,13 @@ impl<const N: usize> Controller<N> {
         }
         if let Some(bias) = &self.bias {
             total += bias.beta();
+        }
+        if let Some(max) = self.max_force {
+            // Saturation keeps the direction: scaled down, damping is still dissipative.
+            let norm = total.norm();
+            if norm > max {
+                total *= max / norm;
+            }
         }
         let mut speed_limited = false;
         if let Some(limit) = &self.speed_limit {
@@ -173,6 +183,7 @@ impl Controller<2> {
             }),
             bias: settings.bias.map(|b| Bias::new(b.alpha, b.dwell)),
             speed_limit: settings.speed_limit.map(|v_max| SpeedLimit { v_max, mass }),
+            max_force: settings.max_force,
         }
     }
 }
@@ -192,6 +203,7 @@ mod tests {
             vd: None,
             f0: None,
             speed_limit: None,
+            max_force: None,
             clamp: None,
             bias: None,
         }
@@ -257,6 +269,17 @@ mod tests {
         let mut c = Controller::from_settings(&s, GuidanceKind::Normalized, 1.0);
         let out = c.step(&input([5.0, 0.0], [0.0, 0.0], Some([1.0, 0.0])));
         assert_eq!(out.force, Vector2::new(-50.0, 0.0));
+    }
+
+    #[test]
+    fn saturation_scales_the_force_down_keeping_its_direction() {
+        let mut s = settings(ControllerKind::Viscous);
+        s.max_force = Some(2.0);
+        let mut c = Controller::from_settings(&s, GuidanceKind::Gradient, 1.0);
+        // Guidance -K·g = (-3, 0), damping -B·v = (0, -40): 40.1 N, scaled to 2 N.
+        let out = c.step(&input([5.0, 0.0], [0.0, 4.0], Some([3.0, 0.0])));
+        let expected = Vector2::new(-3.0, -40.0) * (2.0 / 1609.0f64.sqrt());
+        assert!((out.force - expected).norm() < 1e-12, "{}", out.force);
     }
 
     #[test]

@@ -6,9 +6,15 @@
 //! ([`harmonic`]; [`laplace`] keeps a plain SOR solver as the reference), and the result is
 //! sampled smoothly anywhere in the box ([`sample`]); the kinematic path is the streamline of
 //! the normalized guidance from the start ([`streamline`]).
+//!
+//! With several agents, each agent's field treats the others as obstacles: discs at their
+//! current positions, grown by both radii ([`Disc`]). Khatib's attractive-repulsive potential
+//! ([`firas`]) is the baseline of the narrow corridor; [`GuidanceField`] holds either.
 
 pub mod export;
+pub mod firas;
 pub mod grid;
+pub mod guidance_field;
 pub mod harmonic;
 pub mod laplace;
 pub mod mask;
@@ -20,7 +26,9 @@ use std::time::{Duration, Instant};
 
 use nalgebra::Vector2;
 
+pub use firas::{AttractiveRepulsive, Disc};
 pub use grid::Grid;
+pub use guidance_field::GuidanceField;
 pub use sample::Sampler;
 pub use streamline::Streamline;
 
@@ -111,8 +119,32 @@ impl FreeSpace {
         position: [f64; 2],
         offsets: &[f64],
     ) -> Result<Self, FieldError> {
+        Self::among(world, agent, position, offsets, &[])
+    }
+
+    /// Like [`FreeSpace::sensed`] with the discs `others` (the other agents) as obstacles too.
+    /// A disc that covers the agent's target or the agent itself is left out: an agent parked
+    /// on another's target must not make that target unreachable for good, and two agents in
+    /// contact must still each have a field (the contact is counted by the simulation).
+    pub fn among(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        offsets: &[f64],
+        others: &[Disc],
+    ) -> Result<Self, FieldError> {
         let grid = Grid::anchored(world.size, world.field.cell, agent.target);
-        let walls = all_wall_shapes(world);
+        let mut walls = all_wall_shapes(world);
+        let margin = agent.radius + std::f64::consts::SQRT_2 * grid.cell;
+        let covers = |d: &Disc, p: [f64; 2]| {
+            (p[0] - d.center[0]).hypot(p[1] - d.center[1]) < d.radius + margin
+        };
+        walls.extend(
+            others
+                .iter()
+                .filter(|d| !covers(d, agent.target) && !covers(d, position))
+                .map(Disc::shape),
+        );
         let blocked = mask::rasterize_sensed(&grid, world.size, &walls, agent.radius, offsets);
         let target_cell = grid
             .cell_of(agent.target)
@@ -159,8 +191,21 @@ impl HarmonicField {
         offsets: &[f64],
         previous: Option<&HarmonicField>,
     ) -> Result<Self, FieldError> {
+        Self::solve_among(world, agent, position, offsets, &[], previous)
+    }
+
+    /// Like [`HarmonicField::solve_sensed`] with the discs `others` (the other agents) as
+    /// obstacles too (see [`FreeSpace::among`]).
+    pub fn solve_among(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        offsets: &[f64],
+        others: &[Disc],
+        previous: Option<&HarmonicField>,
+    ) -> Result<Self, FieldError> {
         let started = Instant::now();
-        let space = FreeSpace::sensed(world, agent, position, offsets)?;
+        let space = FreeSpace::among(world, agent, position, offsets, others)?;
         let warm = previous.map(|f| f.sampler.w_cells());
         Self::solve_space(world, agent, space, warm, started)
     }

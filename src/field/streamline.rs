@@ -22,16 +22,39 @@ pub fn streamline(
     target: [f64; 2],
     max_length: f64,
 ) -> Streamline {
-    let h = 0.5 * sampler.grid().cell;
+    let cell = sampler.grid().cell;
+    // ∇W = -∇V: the direction of descent.
+    integrate(
+        |p| sampler.grad_w(p),
+        start,
+        target,
+        0.5 * cell,
+        cell,
+        max_length,
+    )
+}
+
+/// Integrates `ẋ = f(x)/|f(x)|` with the midpoint rule at steps of `h` metres from `start` until
+/// it is within `close` of `target` (reached), `f` vanishes or is undefined, the direction
+/// reverses from one step to the next (a local minimum or a saddle: the path would only bounce
+/// there), or it has walked `max_length` metres.
+pub fn integrate(
+    f: impl Fn([f64; 2]) -> Option<Vector2<f64>>,
+    start: [f64; 2],
+    target: [f64; 2],
+    h: f64,
+    close: f64,
+    max_length: f64,
+) -> Streamline {
     let direction = |p: [f64; 2]| -> Option<Vector2<f64>> {
-        let g = sampler.grad_w(p)?;
+        let g = f(p)?;
         let n = g.norm();
         (n > 0.0 && n.is_finite()).then(|| g / n)
     };
     let mut points = vec![start];
     let mut p = start;
     let mut walked = 0.0;
-    let close = sampler.grid().cell;
+    let mut last: Option<Vector2<f64>> = None;
     let reached = loop {
         if (p[0] - target[0]).hypot(p[1] - target[1]) <= close {
             break true;
@@ -44,6 +67,10 @@ pub fn streamline(
         let Some(d2) = direction(mid) else {
             break false;
         };
+        if last.is_some_and(|l| l.dot(&d2) < 0.0) {
+            break false;
+        }
+        last = Some(d2);
         p = [p[0] + h * d2.x, p[1] + h * d2.y];
         walked += h;
         points.push(p);

@@ -138,21 +138,22 @@ impl Recorder {
         self.trails = vec![Vec::new(); sim.agents.len()];
         for run in &sim.agents {
             let name = &run.agent.name;
-            let field = &run.field;
-            let grid = *field.grid();
-            let (image, resolution) = colormap::potential_image(field);
-            rec.log_static(
-                format!("agents/{name}/field/potential"),
-                &rerun::Transform3D::from_translation_scale(
-                    [grid.origin[0] as f32, grid.origin[1] as f32, 0.0],
-                    rerun::Scale3D::from([grid.cell as f32, grid.cell as f32, 1.0]),
-                ),
-            )?;
-            rec.log_static(
-                format!("agents/{name}/field/potential"),
-                &rerun::Image::from_rgb24(image, resolution).with_draw_order(-10.0),
-            )?;
-            let (origins, vectors) = guidance_arrows(run);
+            if let Some(field) = run.field.harmonic() {
+                let grid = *field.grid();
+                let (image, resolution) = colormap::potential_image(field);
+                rec.log_static(
+                    format!("agents/{name}/field/potential"),
+                    &rerun::Transform3D::from_translation_scale(
+                        [grid.origin[0] as f32, grid.origin[1] as f32, 0.0],
+                        rerun::Scale3D::from([grid.cell as f32, grid.cell as f32, 1.0]),
+                    ),
+                )?;
+                rec.log_static(
+                    format!("agents/{name}/field/potential"),
+                    &rerun::Image::from_rgb24(image, resolution).with_draw_order(-10.0),
+                )?;
+            }
+            let (origins, vectors) = guidance_arrows(sim, run);
             rec.log_static(
                 format!("agents/{name}/field/guidance"),
                 &rerun::Arrows2D::from_vectors(vectors)
@@ -427,19 +428,30 @@ fn outline(wall: &Wall) -> Vec<[f32; 2]> {
     }
 }
 
-/// A sparse field of unit guidance arrows `-∇V/|∇V|` at reachable cells.
-fn guidance_arrows(run: &crate::sim::AgentRun) -> (Vec<[f32; 2]>, Vec<[f32; 2]>) {
-    let grid = *run.field.grid();
-    let stride = (grid.nx.max(grid.ny) / GUIDANCE_ARROWS).max(1);
-    let length = 0.6 * stride as f64 * grid.cell;
-    let reachable = run.field.sampler.reachable_cells();
+/// A sparse field of unit guidance arrows `-∇V/|∇V|`: at reachable cells of a harmonic field,
+/// at the free points of a regular lattice for an attractive-repulsive one.
+fn guidance_arrows(sim: &Simulation, run: &crate::sim::AgentRun) -> (Vec<[f32; 2]>, Vec<[f32; 2]>) {
+    let [w, h] = sim.world.size;
+    let spacing = (w.max(h) / GUIDANCE_ARROWS as f64).min(w.min(h) / 4.0);
+    let length = 0.6 * spacing;
+    let free = |c: [f64; 2]| match run.field.harmonic() {
+        Some(field) => field
+            .grid()
+            .cell_of(c)
+            .is_some_and(|(i, j)| field.sampler.reachable_cells()[field.grid().index(i, j)]),
+        None => {
+            crate::sim::signed_clearance(&sim.walls, nalgebra::Vector2::from(c), run.agent.radius)
+                > 0.0
+        }
+    };
     let (mut origins, mut vectors) = (Vec::new(), Vec::new());
-    for j in (stride / 2..grid.ny).step_by(stride) {
-        for i in (stride / 2..grid.nx).step_by(stride) {
-            if !reachable[grid.index(i, j)] {
+    let (nx, ny) = ((w / spacing) as usize, (h / spacing).max(1.0) as usize);
+    for j in 0..ny {
+        for i in 0..nx {
+            let c = [(i as f64 + 0.5) * spacing, (j as f64 + 0.5) * spacing];
+            if !free(c) {
                 continue;
             }
-            let c = grid.center(i, j);
             if let Some(u) = run.field.gradient(c).and_then(|g| crate::control::unit(&g)) {
                 origins.push(f32x2(c));
                 vectors.push(f32x2([-u.x * length, -u.y * length]));

@@ -6,7 +6,7 @@
 use nalgebra::Vector2;
 
 use crate::control::unit;
-use crate::field::HarmonicField;
+use crate::field::GuidanceField;
 use crate::metrics::Faults;
 
 /// How deep a body may overlap a wall before it counts as pushed into it, m. Rapier's solver
@@ -31,7 +31,7 @@ pub struct FaultMonitor {
 /// What the monitor sees of an agent after a step.
 pub struct Observation<'a> {
     /// The agent's field.
-    pub field: &'a HarmonicField,
+    pub field: &'a GuidanceField,
     /// Position, m.
     pub position: Vector2<f64>,
     /// Signed distance from the disc to the nearest wall, m (negative when overlapping).
@@ -59,9 +59,8 @@ impl FaultMonitor {
     pub fn observe(&mut self, o: &Observation) -> Vec<String> {
         let mut events = Vec::new();
         let p: [f64; 2] = o.position.into();
-        let cell = o.field.grid().cell;
-        let near_target = (o.position - Vector2::from(o.field.target)).norm() <= 2.0 * cell;
-        let w = o.field.one_minus_potential(p);
+        let cell = o.field.cell();
+        let near_target = (o.position - Vector2::from(o.field.target())).norm() <= 2.0 * cell;
         let gradient = o.field.gradient(p);
         let direction = gradient.and_then(|g| unit(&g));
         // Along a streamline the guidance turns slowly; a reversal from one step to the next
@@ -69,7 +68,11 @@ impl FaultMonitor {
         let reversed =
             matches!((direction, self.last_direction), (Some(u), Some(last)) if u.dot(&last) < 0.0);
         self.last_direction = direction;
-        let flat = gradient.is_some_and(|g| g.norm() * cell <= FLAT_RELATIVE_CHANGE * w);
+        // Only a harmonic field can be flat to working precision (in `W = 1 - V`).
+        let flat = o.field.harmonic().is_some_and(|h| {
+            gradient
+                .is_some_and(|g| g.norm() * cell <= FLAT_RELATIVE_CHANGE * h.one_minus_potential(p))
+        });
         let lost = !near_target && (direction.is_none() || flat || reversed);
         if lost {
             self.faults.guidance_lost_steps += 1;

@@ -5,6 +5,12 @@
 //! gradient of its field there, compute the control force, reset the body's forces and apply
 //! the new one (Rapier's user forces persist across steps otherwise), then step Rapier once.
 //! Rapier's narrow phase then says which pairs touch.
+//!
+//! With several agents, each one's field has the others as obstacles (discs grown by both
+//! radii): a harmonic field is re-solved at `field.replan_hz` with the others where they are
+//! then, warm-started from the last solve; an attractive-repulsive one sees them at every step.
+//! A noisy sensor rebuilds the field from each reading. A rebuild that fails (the others or the
+//! sensed walls cut the agent off) keeps the last field and logs a note once.
 
 pub mod faults;
 mod physics;
@@ -20,7 +26,7 @@ pub use physics::{from_rapier, to_rapier};
 pub use sensor::Sensor;
 
 use crate::control::{ControlInput, Controller, unit};
-use crate::field::{FieldError, HarmonicField, Streamline};
+use crate::field::{Disc, FieldError, GuidanceField, HarmonicField, Streamline};
 use crate::metrics::{Metrics, Summary};
 use crate::world::{Agent, WallShape, World, all_wall_shapes};
 use faults::{FaultMonitor, Observation};
@@ -34,8 +40,9 @@ pub const CONTACT_TOLERANCE: f64 = 1e-3;
 pub struct AgentRun {
     /// The agent as the world file describes it.
     pub agent: Agent,
-    /// Its harmonic field: of the true walls, or of the last sensed walls with a sensor.
-    pub field: HarmonicField,
+    /// Its guidance field: of the true walls, or of the last sensed walls with a sensor (and
+    /// the other agents where they were at the last replan).
+    pub field: GuidanceField,
     /// Its wall sensor, if it senses the walls with noise.
     pub sensor: Option<Sensor>,
     /// Its kinematic path (the streamline from its start).
@@ -50,7 +57,9 @@ pub struct AgentRun {
     collider: ColliderHandle,
     touching: HashSet<ColliderHandle>,
     frozen: bool,
-    sensing_failed: bool,
+    rebuild_failed: bool,
+    offsets: Vec<f64>,
+    replans: usize,
 }
 
 /// What happened to one agent in the last step, for recording.
@@ -103,14 +112,32 @@ pub struct Simulation {
 
 impl Simulation {
     /// Builds the Rapier world and solves every agent's field.
+    ///
+    /// With several agents, each field starts with the others at their starts; if they cut an
+    /// agent off from its target there, its first field ignores them (they will move), and only
+    /// a target that the walls alone make unreachable is an error.
     pub fn new(world: &World) -> Result<Self, FieldError> {
         let mut physics = physics::empty_world(world.dt, world.external_acceleration);
         let walls = all_wall_shapes(world);
         physics::insert_walls(&mut physics, &walls);
+        let starts: Vec<Disc> = world
+            .agents
+            .iter()
+            .map(|a| Disc {
+                center: a.start,
+                radius: a.radius,
+            })
+            .collect();
         let mut agents = Vec::with_capacity(world.agents.len());
         for (index, agent) in world.agents.iter().enumerate() {
-            let field = HarmonicField::solve(world, agent)?;
-            let kinematic = field.streamline(agent.start);
+            let others = others_than(&starts, index);
+            let field = match GuidanceField::build(world, agent, &others) {
+                Err(FieldError::Unreachable { .. }) if !others.is_empty() => {
+                    GuidanceField::build(world, agent, &[])?
+                }
+                result => result?,
+            };
+            let kinematic = field.streamline(agent.start, 4.0 * (world.size[0] + world.size[1]));
             let (body, collider) = physics::insert_agent(&mut physics, agent);
             agents.push(AgentRun {
                 controller: Controller::from_settings(
@@ -118,7 +145,7 @@ impl Simulation {
                     world.field.guidance,
                     agent.mass,
                 ),
-                metrics: Metrics::new(&agent.name, agent.start, agent.target),
+                metrics: Metrics::new(&agent.name, agent.start, agent.target, world.distance_at),
                 agent: agent.clone(),
                 field,
                 sensor: agent
@@ -130,7 +157,9 @@ impl Simulation {
                 collider,
                 touching: HashSet::new(),
                 frozen: false,
-                sensing_failed: false,
+                rebuild_failed: false,
+                offsets: Vec::new(),
+                replans: 1,
             });
         }
         Ok(Self {
@@ -159,12 +188,29 @@ impl Simulation {
         let mut events: Vec<Vec<String>> = vec![Vec::new(); self.agents.len()];
         let mut notes: Vec<Vec<String>> = vec![Vec::new(); self.agents.len()];
         let mut sensed: Vec<Option<Vec<[f64; 2]>>> = vec![None; self.agents.len()];
-        for (((run, events), notes), sensed) in self
+        // Every agent's disc where it is now, for the others' fields.
+        let discs: Vec<Disc> = self
+            .agents
+            .iter()
+            .map(|run| {
+                let p = from_rapier(self.physics.bodies[run.body].translation());
+                Disc {
+                    center: if p.iter().all(|c| c.is_finite()) {
+                        p.into()
+                    } else {
+                        *run.metrics.path().last().expect("starts at the start")
+                    },
+                    radius: run.agent.radius,
+                }
+            })
+            .collect();
+        for (index, (((run, events), notes), sensed)) in self
             .agents
             .iter_mut()
             .zip(&mut events)
             .zip(&mut notes)
             .zip(&mut sensed)
+            .enumerate()
         {
             let body = &mut self.physics.bodies[run.body];
             let x = from_rapier(body.translation());
@@ -175,30 +221,53 @@ impl Simulation {
                 events.extend(run.faults.non_finite_state());
             }
             if !run.frozen {
-                if let Some(sensor) = &mut run.sensor
-                    && sensor.due(self.time)
-                {
-                    let offsets = sensor.read(self.walls.len());
-                    match HarmonicField::solve_sensed(
-                        &self.world,
-                        &run.agent,
-                        x.into(),
-                        &offsets,
-                        Some(&run.field),
-                    ) {
-                        Ok(field) => {
-                            run.field = field;
-                            run.sensing_failed = false;
-                            *sensed = Some(boundary(&run.field));
-                        }
-                        Err(e) => {
-                            if !run.sensing_failed {
-                                notes.push(format!(
-                                    "the sensed walls give no usable field ({e}); keeping the last one"
-                                ));
+                let sensed_now = match &mut run.sensor {
+                    Some(sensor) if sensor.due(self.time) => {
+                        run.offsets = sensor.read(self.walls.len());
+                        true
+                    }
+                    _ => false,
+                };
+                let others = others_than(&discs, index);
+                let replan_due = !others.is_empty()
+                    && self.world.field.replan_hz > 0.0
+                    && self.time + 1e-9 >= run.replans as f64 / self.world.field.replan_hz;
+                if replan_due {
+                    run.replans += 1;
+                }
+                match &mut run.field {
+                    GuidanceField::Harmonic(field) if sensed_now || replan_due => {
+                        match HarmonicField::solve_among(
+                            &self.world,
+                            &run.agent,
+                            x.into(),
+                            &run.offsets,
+                            &others,
+                            Some(field),
+                        ) {
+                            Ok(solved) => {
+                                *field = solved;
+                                run.rebuild_failed = false;
+                                if sensed_now {
+                                    *sensed = Some(boundary(field));
+                                }
                             }
-                            run.sensing_failed = true;
+                            Err(e) => {
+                                if !run.rebuild_failed {
+                                    notes.push(format!(
+                                        "the sensed walls and the other agents give no usable field ({e}); keeping the last one"
+                                    ));
+                                }
+                                run.rebuild_failed = true;
+                            }
                         }
+                    }
+                    GuidanceField::Harmonic(_) => {}
+                    GuidanceField::AttractiveRepulsive(field) => {
+                        if sensed_now {
+                            field.sense(&run.offsets);
+                        }
+                        field.set_others(others);
                     }
                 }
                 let input = ControlInput {
@@ -334,6 +403,16 @@ impl Simulation {
             .map(|a| a.metrics.summary(&a.kinematic, &a.faults.faults))
             .collect()
     }
+}
+
+/// Every disc of `discs` but the one at `index`.
+fn others_than(discs: &[Disc], index: usize) -> Vec<Disc> {
+    discs
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| i != index)
+        .map(|(_, d)| *d)
+        .collect()
 }
 
 /// The centres of the blocked cells of `field`'s mask that have a free 4-neighbour: the outline

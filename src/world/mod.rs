@@ -13,8 +13,9 @@ mod validate;
 pub use error::{WorldError, WorldErrors};
 pub use load::{Override, load, load_str, warnings};
 pub use schema::{
-    Agent, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K, Expect,
-    FieldSettings, GuidanceKind, OUTER_WALL_THICKNESS, SensorSettings, Wall, World,
+    Agent, Attraction, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K,
+    Expect, FieldKind, FieldSettings, GuidanceKind, OUTER_WALL_THICKNESS, SensorSettings, Wall,
+    World,
 };
 pub use shapes::{WallShape, all_wall_shapes, all_walls, outer_walls, wall_shape};
 pub use validate::{MAX_CELLS, validate};

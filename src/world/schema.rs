@@ -31,6 +31,10 @@ pub struct World {
     /// controllers do not know it.
     #[serde(default)]
     pub external_acceleration: [f64; 2],
+    /// Time at which each agent's distance from its start is reported as `distance_covered`,
+    /// s (the paper's corridor: "25 metres in 10 seconds").
+    #[serde(default)]
+    pub distance_at: Option<f64>,
     /// How the guidance field is built.
     #[serde(default)]
     pub field: FieldSettings,
@@ -71,6 +75,14 @@ pub struct Expect {
     pub max_peak_speed: Option<f64>,
     /// The peak control force must be at most this, N.
     pub max_peak_force: Option<f64>,
+    /// The speed at the end must be at most this, m/s (a body that must have stopped).
+    pub max_final_speed: Option<f64>,
+    /// The distance from the start at the world's `distance_at` time must be at least this, m.
+    pub min_distance_covered: Option<f64>,
+    /// The distance from the start at the world's `distance_at` time must be at most this, m.
+    pub max_distance_covered: Option<f64>,
+    /// The sideways reversals (`lateral_reversals`) must be at most this many.
+    pub max_lateral_reversals: Option<usize>,
 }
 
 /// Thickness of the walls that `walls_around = true` adds, m.
@@ -80,6 +92,9 @@ pub const OUTER_WALL_THICKNESS: f64 = 0.1;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FieldSettings {
+    /// Which potential guides the agents.
+    #[serde(default)]
+    pub kind: FieldKind,
     /// Grid spacing, m.
     #[serde(default = "default_cell")]
     pub cell: f64,
@@ -92,6 +107,44 @@ pub struct FieldSettings {
     /// The largest grid accepted, in cells (about 40 bytes of memory each, per agent).
     #[serde(default = "default_max_cells")]
     pub max_cells: u64,
+    /// With several agents: how often each agent's field is rebuilt with the others at their
+    /// current positions, Hz (0: only at the start). A harmonic field is re-solved, warm-started
+    /// from the last one; an attractive-repulsive one sees the others at every step regardless.
+    #[serde(default = "default_replan_hz")]
+    pub replan_hz: f64,
+    /// `attractive-repulsive`: how the target attracts.
+    #[serde(default)]
+    pub attraction: Attraction,
+    /// `attractive-repulsive`: the FIRAS gain η, m³ (required with that kind).
+    #[serde(default)]
+    pub eta: Option<f64>,
+    /// `attractive-repulsive`: the range ρ0 of the repulsion, m (required with that kind).
+    #[serde(default)]
+    pub rho0: Option<f64>,
+}
+
+/// Which potential guides the agents.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FieldKind {
+    /// The harmonic potential: Laplace's equation on the free space (eq. 3), no local minima.
+    #[default]
+    Harmonic,
+    /// Khatib's potential: attraction to the target plus FIRAS repulsion
+    /// `½η(1/ρ − 1/ρ0)²` from every obstacle within ρ0 (§VI.6). It has local minima.
+    AttractiveRepulsive,
+}
+
+/// How the target attracts in an attractive-repulsive field (`d` is the distance to it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Attraction {
+    /// `U = d`: a pull of constant magnitude (a spring `d²/(2 r_c)` inside the agent's
+    /// capture radius `r_c`).
+    #[default]
+    Conic,
+    /// `U = ½ d²`: a spring, pulling harder the farther the target.
+    Quadratic,
 }
 
 impl Default for FieldSettings {
@@ -101,6 +154,11 @@ impl Default for FieldSettings {
             guidance: GuidanceKind::default(),
             tolerance: default_tolerance(),
             max_cells: default_max_cells(),
+            kind: FieldKind::default(),
+            replan_hz: default_replan_hz(),
+            attraction: Attraction::default(),
+            eta: None,
+            rho0: None,
         }
     }
 }
@@ -206,6 +264,10 @@ pub struct ControllerSettings {
     /// accelerate the body further along its velocity is dropped (paper §VI.2).
     #[serde(default)]
     pub speed_limit: Option<f64>,
+    /// Actuator saturation `F_max`, N: a control force longer than this is scaled down to it
+    /// (direction kept), before the speed limit.
+    #[serde(default)]
+    pub max_force: Option<f64>,
     /// Clamping control near the target (eq. 35–36).
     #[serde(default)]
     pub clamp: Option<ClampSettings>,
@@ -293,6 +355,9 @@ fn default_duration() -> f64 {
 }
 fn default_cell() -> f64 {
     0.05
+}
+fn default_replan_hz() -> f64 {
+    10.0
 }
 fn default_tolerance() -> f64 {
     1e-12

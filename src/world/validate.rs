@@ -2,7 +2,10 @@
 //! agents that start in free space. Each problem is a dotted key path and a message; the loader
 //! turns the path into a line of the file.
 
-use super::schema::{Agent, ControllerKind, ControllerSettings, Expect, GuidanceKind, Wall, World};
+use super::schema::{
+    Agent, Attraction, ControllerKind, ControllerSettings, Expect, FieldKind, FieldSettings,
+    GuidanceKind, Wall, World,
+};
 use super::shapes::{outer_walls, wall_shape};
 
 /// The default of `field.max_cells`, the largest grid accepted (4096 × 4096 cells, about 640 MB
@@ -19,6 +22,9 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
     positive(&mut bad, "size.1", world.size[1]);
     positive(&mut bad, "dt", world.dt);
     positive(&mut bad, "duration", world.duration);
+    if let Some(at) = world.distance_at {
+        non_negative(&mut bad, "distance_at", at);
+    }
     positive(&mut bad, "field.cell", world.field.cell);
     finite_point(
         &mut bad,
@@ -48,6 +54,8 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
             );
         }
     }
+    check_field_kind(&mut bad, &world.field);
+    non_negative(&mut bad, "field.replan_hz", world.field.replan_hz);
     if world.dt.is_finite() && world.duration.is_finite() && world.dt > world.duration {
         bad(
             "dt".into(),
@@ -194,7 +202,12 @@ fn check_controller(
     if let Some(b) = c.b {
         non_negative(bad, &key("b"), b);
     }
-    for (name, value) in [("vd", c.vd), ("f0", c.f0), ("speed_limit", c.speed_limit)] {
+    for (name, value) in [
+        ("vd", c.vd),
+        ("f0", c.f0),
+        ("speed_limit", c.speed_limit),
+        ("max_force", c.max_force),
+    ] {
         if let Some(x) = value {
             positive(bad, &key(name), x);
         }
@@ -210,6 +223,41 @@ fn check_controller(
     }
 }
 
+/// The attractive-repulsive keys: required with that kind, rejected without it (a stray `eta`
+/// in a harmonic world would otherwise be silently ignored).
+fn check_field_kind(bad: &mut impl FnMut(String, String), field: &FieldSettings) {
+    let keys = [("field.eta", field.eta), ("field.rho0", field.rho0)];
+    match field.kind {
+        FieldKind::AttractiveRepulsive => {
+            for (key, value) in keys {
+                match value {
+                    Some(x) => positive(bad, key, x),
+                    None => bad(
+                        key.into(),
+                        "is required with field.kind = \"attractive-repulsive\"".into(),
+                    ),
+                }
+            }
+        }
+        FieldKind::Harmonic => {
+            for (key, value) in keys {
+                if value.is_some() {
+                    bad(
+                        key.into(),
+                        "is only used with field.kind = \"attractive-repulsive\"".into(),
+                    );
+                }
+            }
+            if field.attraction != Attraction::default() {
+                bad(
+                    "field.attraction".into(),
+                    "is only used with field.kind = \"attractive-repulsive\"".into(),
+                );
+            }
+        }
+    }
+}
+
 fn check_expect(bad: &mut impl FnMut(String, String), key: &str, e: &Expect) {
     for (name, value) in [
         ("max_settling_time", e.max_settling_time),
@@ -218,6 +266,9 @@ fn check_expect(bad: &mut impl FnMut(String, String), key: &str, e: &Expect) {
         ("max_deviation", e.max_deviation),
         ("max_peak_speed", e.max_peak_speed),
         ("max_peak_force", e.max_peak_force),
+        ("max_final_speed", e.max_final_speed),
+        ("min_distance_covered", e.min_distance_covered),
+        ("max_distance_covered", e.max_distance_covered),
     ] {
         if let Some(x) = value
             && !(x.is_finite() && x >= 0.0)

@@ -1,0 +1,56 @@
+//! Several agents (the paper's §VI.7): each one's harmonic field has the others as obstacles,
+//! re-solved as they move; agent–agent touches count as contacts.
+
+mod common;
+
+#[test]
+fn nadf_swaps_two_robots_without_contact_in_under_half_the_viscous_time() {
+    let run = |name: &str| {
+        nadf::run::run(&common::world(name, &[]), &Default::default())
+            .unwrap()
+            .agents
+    };
+    let nadf = run("swap.toml");
+    let viscous = run("swap-viscous.toml");
+    for s in nadf.iter().chain(&viscous) {
+        assert!(s.reached, "{s:?}");
+        assert_eq!(s.contacts, 0, "{s:?}");
+    }
+    let (fast, slow) = (
+        nadf[0].settling_time.unwrap(),
+        viscous[0].settling_time.unwrap(),
+    );
+    eprintln!("robot1 settles in {fast:.2} s with NADF, {slow:.2} s with viscous damping");
+    assert!(fast < 0.5 * slow, "{fast} vs {slow}");
+}
+
+#[test]
+fn without_replanning_the_robots_run_into_each_other_and_it_counts() {
+    // Solved once at the start, robot 2 sits on robot 1's target and is left out of its field
+    // (and the other way round): both head straight for each other.
+    let world = common::world(
+        "swap.toml",
+        &[
+            "field.replan_hz=0",
+            "agents.0.start=[2.0,7.0]",
+            "agents.0.target=[12.0,7.0]",
+            "agents.1.start=[12.0,7.0]",
+            "agents.1.target=[2.0,7.0]",
+        ],
+    );
+    let report = nadf::run::run(&world, &Default::default()).unwrap();
+    for s in &report.agents {
+        assert!(s.contacts >= 1, "{s:?}");
+    }
+}
+
+#[test]
+fn a_crowd_crosses_the_room_without_contact() {
+    let report = nadf::run::run(&common::world("crowd.toml", &[]), &Default::default()).unwrap();
+    assert_eq!(report.agents.len(), 8);
+    for s in &report.agents {
+        assert!(s.reached, "{s:?}");
+        assert_eq!(s.contacts, 0, "{s:?}");
+        assert!(s.faults.is_clean(), "{s:?}");
+    }
+}
