@@ -20,6 +20,44 @@ pub fn failures(world: &World, summaries: &[Summary]) -> Vec<String> {
     out
 }
 
+/// Every `[pendulums.expect]` of `world` that these pendulum summaries miss.
+pub fn pendulum_failures(
+    world: &World,
+    summaries: &[crate::sim::pendulum::PendulumSummary],
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for (p, s) in world.pendulums.iter().zip(summaries) {
+        let Some(e) = &p.expect else { continue };
+        let error = s.final_error.abs();
+        if let Some(b) = e.max_final_error
+            && (error > b || error.is_nan())
+        {
+            out.push(format!(
+                "{}: final_error = {error:.6} rad, expected ≤ {b} rad",
+                s.name
+            ));
+        }
+        if let Some(b) = e.min_final_error
+            && (error < b || error.is_nan())
+        {
+            out.push(format!(
+                "{}: final_error = {error:.6} rad, expected ≥ {b} rad",
+                s.name
+            ));
+        }
+        if let Some(n) = e.max_bias_updates
+            && s.bias_updates.len() > n
+        {
+            out.push(format!(
+                "{}: {} bias updates, expected at most {n}",
+                s.name,
+                s.bias_updates.len()
+            ));
+        }
+    }
+    out
+}
+
 /// The expectations in `e` that `s` misses.
 pub fn check(e: &Expect, s: &Summary) -> Vec<String> {
     let mut failed = Vec::new();

@@ -207,7 +207,8 @@ fn run_command(
                 );
                 return ExitCode::from(INTERRUPTED);
             }
-            let failures = nadf::expect::failures(&world, &report.agents);
+            let mut failures = nadf::expect::failures(&world, &report.agents);
+            failures.extend(nadf::expect::pendulum_failures(&world, &report.pendulums));
             if failures.is_empty() {
                 ExitCode::SUCCESS
             } else {

@@ -12,6 +12,7 @@ use crate::field::FieldError;
 use crate::metrics::Summary;
 use crate::record::{RecordError, Recorder};
 use crate::sim::Simulation;
+use crate::sim::pendulum::PendulumSummary;
 use crate::world::World;
 
 /// What a run writes.
@@ -58,6 +59,9 @@ pub struct Report {
     pub world: String,
     /// One summary per agent, in the world file's order.
     pub agents: Vec<Summary>,
+    /// One summary per pendulum, in the world file's order (left out of the JSON when none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pendulums: Vec<PendulumSummary>,
     /// Wall-clock time of the whole run (fields, simulation, recording).
     #[serde(skip)]
     pub wall_time: Duration,
@@ -159,6 +163,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
     let report = Report {
         world: world.name().to_string(),
         agents: sim.summaries(),
+        pendulums: sim.pendulum_summaries(),
         wall_time: started.elapsed(),
         recording,
         fields,
@@ -208,20 +213,22 @@ impl Report {
                 f.solve_time.as_secs_f64() * 1e3
             );
         }
-        out += &format!(
-            "{:<12} {:>7} {:>9} {:>9} {:>8} {:>9} {:>9} {:>8} {:>8} {:>9} {:>8}\n",
-            "agent",
-            "reached",
-            "settle_s",
-            "error_m",
-            "contacts",
-            "clear_m",
-            "dev_m",
-            "path_m",
-            "peak_N",
-            "var_N",
-            "vmax"
-        );
+        if !self.agents.is_empty() {
+            out += &format!(
+                "{:<12} {:>7} {:>9} {:>9} {:>8} {:>9} {:>9} {:>8} {:>8} {:>9} {:>8}\n",
+                "agent",
+                "reached",
+                "settle_s",
+                "error_m",
+                "contacts",
+                "clear_m",
+                "dev_m",
+                "path_m",
+                "peak_N",
+                "var_N",
+                "vmax"
+            );
+        }
         for s in &self.agents {
             let settle = s
                 .settling_time
@@ -240,6 +247,34 @@ impl Report {
                 s.control_variation,
                 s.peak_speed
             );
+        }
+        if !self.pendulums.is_empty() {
+            out += &format!(
+                "{:<12} {:>12} {:>9} {:>12} {:>8} {:>7}\n",
+                "pendulum", "error_rad", "settle_s", "static_rad", "peak_Nm", "updates"
+            );
+        }
+        for p in &self.pendulums {
+            out += &format!(
+                "{:<12} {:>12.6} {:>9} {:>12} {:>8.2} {:>7}\n",
+                p.name,
+                p.final_error,
+                p.settling_time
+                    .map_or_else(|| "never".to_string(), |t| format!("{t:.2}")),
+                p.static_error
+                    .map_or_else(|| "-".to_string(), |e| format!("{e:.6}")),
+                p.peak_torque,
+                p.bias_updates.len()
+            );
+            for (i, u) in p.bias_updates.iter().enumerate() {
+                out += &format!(
+                    "  update {} at {:.2} s: error {:.6} rad, β = {:.4} N·m\n",
+                    i + 1,
+                    u.time,
+                    u.error,
+                    u.beta
+                );
+            }
         }
         for s in self.agents.iter().filter(|s| !s.faults.is_clean()) {
             let f = &s.faults;

@@ -306,7 +306,7 @@ fn field_exports_numpy_arrays_and_a_picture() {
 #[test]
 fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&str, &[&str], &[&str]); 3] = [
+    let cases: [(&str, &[&str], &[&str]); 6] = [
         (
             "room-speed-limit.toml",
             &["plots/robot/speed_limited"],
@@ -327,9 +327,38 @@ fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
             &["plots/robot/clamping", "agents/robot/sensed_walls"],
             &["plots/robot/beta_x"],
         ),
+        (
+            "pendulum-bias.toml",
+            &[
+                "world/pendulums/pendulum/rod",
+                "world/pendulums/pendulum/bob",
+                "world/pendulums/pendulum/events",
+                "plots/pendulum/theta",
+                "plots/pendulum/torque",
+                "plots/pendulum/beta",
+            ],
+            &["agents/robot/body"],
+        ),
+        (
+            // Khatib's field has no grid: arrows, no potential image.
+            "corridor-obstruction.toml",
+            &["agents/robot/field/guidance", "agents/robot/kinematic_path"],
+            &["agents/robot/field/potential"],
+        ),
+        (
+            "swap.toml",
+            &["agents/robot1/body", "agents/robot2/body"],
+            &[],
+        ),
     ];
     for (world, present, absent) in cases {
         let path = world_path(world);
+        // Long enough for each world's [expect] table to hold.
+        let duration = if world.starts_with("corridor") {
+            "duration=20"
+        } else {
+            "duration=8"
+        };
         let out = nadf(
             dir.path(),
             &[
@@ -338,7 +367,7 @@ fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
                 "-o",
                 "r.rrd",
                 "--set",
-                "duration=8",
+                duration,
             ],
         );
         common::assert_success(&out);

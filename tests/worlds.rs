@@ -18,8 +18,9 @@ fn every_shipped_world_meets_its_expectations() {
     assert!(worlds.len() >= 3);
     for path in worlds {
         let world = nadf::world::load(&path, &[]).unwrap();
-        let has_expectations =
-            world.expect.is_some() || world.agents.iter().any(|a| a.expect.is_some());
+        let has_expectations = world.expect.is_some()
+            || world.agents.iter().any(|a| a.expect.is_some())
+            || world.pendulums.iter().any(|p| p.expect.is_some());
         assert!(has_expectations, "{} has no [expect] table", path.display());
         let dir = tempfile::tempdir().unwrap();
         let json = dir.path().join("s.json");

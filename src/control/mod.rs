@@ -5,7 +5,8 @@
 //!
 //! Each law is one [`ControlLaw`]: the guidance force ([`Guidance`]), a damping law
 //! ([`Viscous`], eq. 1, or [`Nadf`], eq. 9–10), the sliding-mode baseline ([`SlidingMode`],
-//! eq. 72–73) and the clamping control ([`Clamp`], eq. 35). A [`Controller`] sums its laws
+//! eq. 72–73), the clamping control ([`Clamp`], eq. 35) and, for the pendulum, a plain spring
+//! ([`Spring`], eq. 75). A [`Controller`] sums its laws
 //! (eq. 36: `F = -B_d M - K ∇V - K_c F_c`), adds the iterative bias ([`Bias`], eq. 48–50) and
 //! applies the speed limit ([`SpeedLimit`], §VI.2) last.
 
@@ -15,6 +16,7 @@ mod guidance;
 mod nadf;
 mod sliding_mode;
 mod speed_limit;
+mod spring;
 mod viscous;
 
 pub use bias::Bias;
@@ -23,6 +25,7 @@ pub use guidance::{Guidance, GuidanceMode};
 pub use nadf::{Nadf, step};
 pub use sliding_mode::SlidingMode;
 pub use speed_limit::SpeedLimit;
+pub use spring::Spring;
 pub use viscous::Viscous;
 
 use nalgebra::SVector;

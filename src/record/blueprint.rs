@@ -44,6 +44,26 @@ pub fn layout(world: &World) -> Blueprint {
     if world.agents.iter().any(|a| a.controller.bias.is_some()) {
         views.push(series("bias β (N)", &["beta_x", "beta_y"]).into());
     }
+    if !world.pendulums.is_empty() {
+        let pendulum_series = |title: &str, names: &[&str]| {
+            let contents: Vec<String> = world
+                .pendulums
+                .iter()
+                .flat_map(|p| {
+                    names
+                        .iter()
+                        .map(move |n| format!("+ /plots/{}/{n}", p.name))
+                })
+                .collect();
+            TimeSeriesView::new(title).with_contents(contents)
+        };
+        if world.agents.is_empty() {
+            views.clear();
+        }
+        views.push(pendulum_series("pendulum angle θ (rad)", &["theta", "target"]).into());
+        views.push(pendulum_series("torque u (N·m)", &["torque"]).into());
+        views.push(pendulum_series("bias β (N·m)", &["beta"]).into());
+    }
     Blueprint::new(
         Horizontal::new([
             Spatial2DView::new(world.name())

@@ -16,6 +16,9 @@
 //! - `plots/NAME/{clamping, speed_limited}` (0 or 1) and `plots/NAME/{beta_x, beta_y}` (N):
 //!   when the agent's controller has a clamp, a speed limit or a bias.
 //!
+//! - `world/pendulums/NAME/{pivot, target, rod, bob}`: a pendulum; `…/events` its bias updates
+//!   (INFO); `plots/NAME/{theta, target, torque, beta}`: θ(t), θ_T, u(t) and β(t).
+//!
 //! Time is the `sim_time` timeline, in seconds. The world is y-up while Rerun's 2D views are
 //! y-down, so `world` and `agents` carry a static transform that flips y about the box.
 //!
@@ -135,6 +138,38 @@ impl Recorder {
                 .with_colors([rerun::Color::from_rgb(230, 230, 230)])
                 .with_radii([0.02]),
         )?;
+        for p in &sim.pendulums {
+            let name = &p.pendulum.name;
+            rec.log_static(
+                format!("world/pendulums/{name}/pivot"),
+                &rerun::Points2D::new([f32x2(p.pendulum.pivot)])
+                    .with_radii([0.04])
+                    .with_colors([rerun::Color::from_rgb(230, 230, 230)]),
+            )?;
+            let target = p.pendulum.target;
+            let [px, py] = p.pendulum.pivot;
+            let l = p.pendulum.length;
+            rec.log_static(
+                format!("world/pendulums/{name}/target"),
+                &rerun::LineStrips2D::new([[
+                    f32x2([px, py]),
+                    f32x2([px + l * target.sin(), py - l * target.cos()]),
+                ]])
+                .with_colors([rerun::Color::from_rgb(80, 255, 120)])
+                .with_radii([0.01]),
+            )?;
+            for (series, label) in [
+                ("theta", "θ (rad)"),
+                ("target", "θ_T (rad)"),
+                ("torque", "u (N·m)"),
+                ("beta", "β (N·m)"),
+            ] {
+                rec.log_static(
+                    format!("plots/{name}/{series}"),
+                    &rerun::SeriesLines::new().with_names([label]),
+                )?;
+            }
+        }
         self.trails = vec![Vec::new(); sim.agents.len()];
         for run in &sim.agents {
             let name = &run.agent.name;
@@ -224,6 +259,39 @@ impl Recorder {
         let rec = &self.stream;
         rec.set_duration_secs("sim_time", sim.time());
         self.steps += 1;
+        for p in &sim.pendulums {
+            let name = &p.pendulum.name;
+            let s = &p.state;
+            rec.log(
+                format!("world/pendulums/{name}/rod"),
+                &rerun::LineStrips2D::new([[f32x2(p.pendulum.pivot), f32x2(s.bob)]])
+                    .with_colors([rerun::Color::from_rgb(200, 200, 200)])
+                    .with_radii([0.015]),
+            )?;
+            rec.log(
+                format!("world/pendulums/{name}/bob"),
+                &rerun::Points2D::new([f32x2(s.bob)])
+                    .with_radii([0.08])
+                    .with_colors([rerun::Color::from_rgb(255, 170, 40)]),
+            )?;
+            for (series, value) in [
+                ("theta", s.theta),
+                ("target", p.pendulum.target),
+                ("torque", s.torque),
+                ("beta", s.beta),
+            ] {
+                rec.log(
+                    format!("plots/{name}/{series}"),
+                    &rerun::Scalars::single(value),
+                )?;
+            }
+            if let Some(note) = &s.note {
+                rec.log(
+                    format!("world/pendulums/{name}/events"),
+                    &rerun::TextLog::new(note.as_str()).with_level(rerun::TextLogLevel::INFO),
+                )?;
+            }
+        }
         for ((run, state), trail) in sim.agents.iter().zip(states).zip(&mut self.trails) {
             let name = &run.agent.name;
             let p = [state.position.x as f32, state.position.y as f32];

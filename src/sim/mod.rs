@@ -1,5 +1,6 @@
-//! The simulation: a Rapier world with the walls as fixed colliders and each agent as a dynamic
-//! disc, and the step loop that closes the control loop through it.
+//! The simulation: a Rapier world with the walls as fixed colliders, each agent as a dynamic
+//! disc and each pendulum on a revolute joint ([`pendulum`]), and the step loop that closes the
+//! control loop through it.
 //!
 //! Every step, for every agent: read its position and velocity from Rapier, sample the
 //! gradient of its field there, compute the control force, reset the body's forces and apply
@@ -13,6 +14,7 @@
 //! sensed walls cut the agent off) keeps the last field and logs a note once.
 
 pub mod faults;
+pub mod pendulum;
 mod physics;
 mod sensor;
 
@@ -105,6 +107,8 @@ pub struct Simulation {
     pub walls: Vec<WallShape>,
     /// The agents.
     pub agents: Vec<AgentRun>,
+    /// The pendulums.
+    pub pendulums: Vec<pendulum::PendulumRun>,
     physics: PhysicsWorld,
     time: f64,
     steps: usize,
@@ -162,10 +166,16 @@ impl Simulation {
                 replans: 1,
             });
         }
+        let pendulums = world
+            .pendulums
+            .iter()
+            .map(|p| pendulum::insert(&mut physics, p))
+            .collect();
         Ok(Self {
             world: world.clone(),
             walls,
             agents,
+            pendulums,
             physics,
             time: 0.0,
             steps: 0,
@@ -301,9 +311,15 @@ impl Simulation {
             run.metrics.record_force(force);
             controls.push(control);
         }
+        for p in &mut self.pendulums {
+            p.control(&mut self.physics, self.world.dt);
+        }
         self.physics.step();
         self.steps += 1;
         self.time = self.steps as f64 * self.world.dt;
+        for p in &mut self.pendulums {
+            p.observe(&self.physics, self.time, self.world.dt);
+        }
 
         let mut states = Vec::with_capacity(self.agents.len());
         for ((((run, control), mut events), notes), sensed_walls) in self
@@ -394,6 +410,14 @@ impl Simulation {
             });
         }
         states
+    }
+
+    /// Each pendulum's summary so far.
+    pub fn pendulum_summaries(&self) -> Vec<pendulum::PendulumSummary> {
+        self.pendulums
+            .iter()
+            .map(|p| p.summary(self.world.external_acceleration))
+            .collect()
     }
 
     /// Each agent's summary so far.

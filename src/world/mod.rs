@@ -14,8 +14,8 @@ pub use error::{WorldError, WorldErrors};
 pub use load::{Override, load, load_str, warnings};
 pub use schema::{
     Agent, Attraction, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K,
-    Expect, FieldKind, FieldSettings, GuidanceKind, OUTER_WALL_THICKNESS, SensorSettings, Wall,
-    World,
+    Expect, FieldKind, FieldSettings, GuidanceKind, OUTER_WALL_THICKNESS, Pendulum,
+    PendulumController, PendulumExpect, SensorSettings, Wall, World,
 };
 pub use shapes::{WallShape, all_wall_shapes, all_walls, outer_walls, wall_shape};
 pub use validate::{MAX_CELLS, validate};

@@ -41,9 +41,13 @@ pub struct World {
     /// Static obstacles.
     #[serde(default)]
     pub walls: Vec<Wall>,
-    /// The controlled bodies (at least one).
+    /// The controlled bodies (a world needs at least one agent or pendulum).
     #[serde(default)]
     pub agents: Vec<Agent>,
+    /// Controlled pendulums (§VI.8): a mass on a massless rod on a revolute joint, under the
+    /// world's `external_acceleration` as gravity.
+    #[serde(default)]
+    pub pendulums: Vec<Pendulum>,
     /// What every agent's run must show (`nadf run` exits 1 when it does not).
     #[serde(default)]
     pub expect: Option<Expect>,
@@ -237,6 +241,60 @@ pub struct Agent {
     pub expect: Option<Expect>,
 }
 
+/// One pendulum (`[[pendulums]]`): a point mass `mass` on a massless rod of `length` about a
+/// fixed `pivot`, on a Rapier revolute joint, driven by a torque `u = K·e − B·θ̇ (+ β)` with
+/// `e = θ_T − θ` (eq. 75 with the target moved off zero, and the bias of eq. 48–50). The angle θ
+/// is measured counter-clockwise from hanging straight down.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pendulum {
+    /// Name, unique in the world; used in entity paths and the summary.
+    pub name: String,
+    /// The pivot, m.
+    pub pivot: [f64; 2],
+    /// Rod length L, m.
+    #[serde(default = "default_length")]
+    pub length: f64,
+    /// The mass M at the end of the rod, kg.
+    #[serde(default = "default_mass")]
+    pub mass: f64,
+    /// Initial angle θ(0), rad.
+    #[serde(default)]
+    pub start: f64,
+    /// Target angle θ_T, rad.
+    pub target: f64,
+    /// The torque law.
+    pub controller: PendulumController,
+    /// What this pendulum's run must show.
+    #[serde(default)]
+    pub expect: Option<PendulumExpect>,
+}
+
+/// The `[pendulums.controller]` table: `u = K·e − B·θ̇ (+ β)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PendulumController {
+    /// Position gain K, N·m/rad.
+    pub k: f64,
+    /// Damping B, N·m·s/rad.
+    pub b: f64,
+    /// The iterative bias (eq. 48–50); α in rad/s.
+    #[serde(default)]
+    pub bias: Option<BiasSettings>,
+}
+
+/// The `[pendulums.expect]` table.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PendulumExpect {
+    /// The final `|θ_T − θ|` must be at most this, rad.
+    pub max_final_error: Option<f64>,
+    /// The final `|θ_T − θ|` must be at least this, rad (a steady-state error that must show).
+    pub min_final_error: Option<f64>,
+    /// At most this many bias updates.
+    pub max_bias_updates: Option<usize>,
+}
+
 /// The `[agents.controller]` table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -369,6 +427,9 @@ fn default_radius() -> f64 {
     0.2
 }
 fn default_mass() -> f64 {
+    1.0
+}
+fn default_length() -> f64 {
     1.0
 }
 fn default_dwell() -> f64 {

@@ -79,11 +79,33 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
         }
     }
 
-    if world.agents.is_empty() {
+    if world.agents.is_empty() && world.pendulums.is_empty() {
         bad(
             "agents".into(),
-            "a world needs at least one [[agents]] entry".into(),
+            "a world needs at least one [[agents]] or [[pendulums]] entry".into(),
         );
+    }
+    for (i, p) in world.pendulums.iter().enumerate() {
+        let key = |name: &str| format!("pendulums.{i}.{name}");
+        finite_point(&mut bad, &key("pivot"), p.pivot);
+        positive(&mut bad, &key("length"), p.length);
+        positive(&mut bad, &key("mass"), p.mass);
+        for (name, x) in [("start", p.start), ("target", p.target)] {
+            if !x.is_finite() {
+                bad(key(name), format!("must be a finite angle, got {x}"));
+            }
+        }
+        non_negative(&mut bad, &key("controller.k"), p.controller.k);
+        non_negative(&mut bad, &key("controller.b"), p.controller.b);
+        if let Some(bias) = &p.controller.bias {
+            positive(&mut bad, &key("controller.bias.alpha"), bias.alpha);
+            non_negative(&mut bad, &key("controller.bias.dwell"), bias.dwell);
+        }
+        if world.agents.iter().any(|a| a.name == p.name)
+            || world.pendulums[..i].iter().any(|q| q.name == p.name)
+        {
+            bad(key("name"), format!("`{}` is used twice", p.name));
+        }
     }
     for (i, agent) in world.agents.iter().enumerate() {
         check_agent(&mut bad, world, i, agent);
