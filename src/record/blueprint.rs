@@ -15,18 +15,8 @@ pub fn layout(world: &World) -> Blueprint {
     for agent in world.agents.iter().skip(1) {
         spatial.push(format!("- /agents/{}/field/**", agent.name));
     }
-    let series = |title: &str, names: &[&str]| {
-        let contents: Vec<String> = world
-            .agents
-            .iter()
-            .flat_map(|a| {
-                names
-                    .iter()
-                    .map(move |n| format!("+ /plots/{}/{n}", a.name))
-            })
-            .collect();
-        TimeSeriesView::new(title).with_contents(contents)
-    };
+    let agents: Vec<&str> = world.agents.iter().map(|a| a.name.as_str()).collect();
+    let series = |title: &str, names: &[&str]| series_view(title, &agents, names);
     let mut views = vec![
         series("distance to target (m)", &["distance"]).into(),
         series("speed (m/s)", &["speed", "radial_speed"]).into(),
@@ -45,18 +35,8 @@ pub fn layout(world: &World) -> Blueprint {
         views.push(series("bias β (N)", &["beta_x", "beta_y"]).into());
     }
     if !world.pendulums.is_empty() {
-        let pendulum_series = |title: &str, names: &[&str]| {
-            let contents: Vec<String> = world
-                .pendulums
-                .iter()
-                .flat_map(|p| {
-                    names
-                        .iter()
-                        .map(move |n| format!("+ /plots/{}/{n}", p.name))
-                })
-                .collect();
-            TimeSeriesView::new(title).with_contents(contents)
-        };
+        let pendulums: Vec<&str> = world.pendulums.iter().map(|p| p.name.as_str()).collect();
+        let pendulum_series = |title: &str, names: &[&str]| series_view(title, &pendulums, names);
         if world.agents.is_empty() {
             views.clear();
         }
@@ -80,4 +60,13 @@ pub fn layout(world: &World) -> Blueprint {
             .with_timeline("sim_time")
             .with_play_state(PlayState::Following),
     )
+}
+
+/// A time-series view of the series `names` of every body in `owners` (`/plots/OWNER/NAME`).
+fn series_view(title: &str, owners: &[&str], names: &[&str]) -> TimeSeriesView {
+    let contents: Vec<String> = owners
+        .iter()
+        .flat_map(|o| names.iter().map(move |n| format!("+ /plots/{o}/{n}")))
+        .collect();
+    TimeSeriesView::new(title).with_contents(contents)
 }
