@@ -109,30 +109,13 @@ impl AttractiveRepulsive {
     /// Distance from the agent's disc at `p` to every obstacle, with the unit vector along
     /// which that distance grows fastest.
     fn obstacles(&self, p: [f64; 2]) -> impl Iterator<Item = (f64, Vector2<f64>)> + '_ {
-        let centre = Vector::new(p[0] as f32, p[1] as f32);
         let walls = self
             .walls
             .iter()
             .zip(&self.offsets)
             .map(move |(w, offset)| {
-                let projection = w.shape.project_point(&w.pose, centre, false);
-                let away = Vector2::new(
-                    f64::from(centre.x - projection.point.x),
-                    f64::from(centre.y - projection.point.y),
-                );
-                let d = away.norm();
-                // Inside the wall the distance grows towards the boundary.
-                let (signed, direction) = if projection.is_inside {
-                    (-d, -away)
-                } else {
-                    (d, away)
-                };
-                let direction = if d > 0.0 {
-                    direction / d
-                } else {
-                    Vector2::zeros()
-                };
-                (signed - offset - self.radius, direction)
+                let (signed, direction) = w.signed_distance_and_direction(p[0], p[1]);
+                (signed - offset - self.radius, Vector2::from(direction))
             });
         let others = self.others.iter().map(move |o| {
             let away = Vector2::new(p[0] - o.center[0], p[1] - o.center[1]);

@@ -21,7 +21,6 @@ mod sensor;
 use std::collections::HashSet;
 
 use nalgebra::Vector2;
-use parry2d::math::Vector;
 use rapier2d::prelude::{ColliderHandle, PhysicsWorld, RigidBodyHandle};
 
 pub use physics::{from_rapier, to_rapier};
@@ -312,13 +311,13 @@ impl Simulation {
             controls.push(control);
         }
         for p in &mut self.pendulums {
-            p.control(&mut self.physics, self.world.dt);
+            p.control(&mut self.physics, self.time, self.world.dt);
         }
         self.physics.step();
         self.steps += 1;
         self.time = self.steps as f64 * self.world.dt;
         for p in &mut self.pendulums {
-            p.observe(&self.physics, self.time, self.world.dt);
+            p.observe(&self.physics, self.time);
         }
 
         let mut states = Vec::with_capacity(self.agents.len());
@@ -466,14 +465,9 @@ fn boundary(field: &HarmonicField) -> Vec<[f64; 2]> {
 /// Signed distance from a disc of `radius` at `position` to the nearest wall, m: positive when
 /// clear, negative by the overlap depth when the disc is inside a wall.
 pub fn signed_clearance(walls: &[WallShape], position: Vector2<f64>, radius: f64) -> f64 {
-    let centre = Vector::new(position.x as f32, position.y as f32);
     walls
         .iter()
-        .map(|w| {
-            let projection = w.shape.project_point(&w.pose, centre, false);
-            let d = f64::from((projection.point - centre).length());
-            if projection.is_inside { -d } else { d }
-        })
+        .map(|w| w.signed_distance_to_point(position.x, position.y))
         .fold(f64::INFINITY, f64::min)
         - radius
 }

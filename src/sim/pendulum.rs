@@ -55,7 +55,7 @@ pub struct PendulumState {
 /// One update of the bias β (a settling instant).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BiasUpdate {
-    /// When, s.
+    /// When: the start of the step in which it was made, s.
     pub time: f64,
     /// The error `θ_T − θ` at that instant, rad.
     pub error: f64,
@@ -169,8 +169,8 @@ pub fn insert(physics: &mut PhysicsWorld, pendulum: &Pendulum) -> PendulumRun {
 }
 
 impl PendulumRun {
-    /// Computes the torque for the coming step and applies it to the bob.
-    pub fn control(&mut self, physics: &mut PhysicsWorld, dt: f64) {
+    /// Computes the torque for the step that starts at `time` (s) and applies it to the bob.
+    pub fn control(&mut self, physics: &mut PhysicsWorld, time: f64, dt: f64) {
         let input = ControlInput {
             offset: Vector1::new(self.state.theta - self.pendulum.target),
             velocity: Vector1::new(self.state.omega),
@@ -185,7 +185,7 @@ impl PendulumRun {
         self.peak_torque = self.peak_torque.max(torque.abs());
         if out.bias_updated {
             let update = BiasUpdate {
-                time: 0.0,
+                time,
                 error: -input.offset.x,
                 beta: self.state.beta,
             };
@@ -203,7 +203,7 @@ impl PendulumRun {
     }
 
     /// Reads the pendulum's state back from Rapier after a step that ended at `time` (s).
-    pub fn observe(&mut self, physics: &PhysicsWorld, time: f64, dt: f64) {
+    pub fn observe(&mut self, physics: &PhysicsWorld, time: f64) {
         let body = &physics.bodies[self.body];
         // Unwrap Rapier's angle in (−π, π] onto the continuous θ.
         let wrapped = f64::from(body.rotation().angle());
@@ -221,12 +221,6 @@ impl PendulumRun {
         }
         let t = body.translation();
         self.state.bob = [f64::from(t.x), f64::from(t.y)];
-        if let Some(last) = self.updates.last_mut()
-            && last.time == 0.0
-        {
-            // Stamped with the end of the step in which it was made.
-            last.time = time - dt;
-        }
         let error = (self.pendulum.target - self.state.theta).abs();
         if error > self.band {
             self.settled_at = None;

@@ -28,10 +28,27 @@ impl WallShape {
     /// Signed distance from `(x, y)` to the wall's boundary, m: positive outside, negative
     /// inside by the depth.
     pub fn signed_distance_to_point(&self, x: f64, y: f64) -> f64 {
+        self.signed_distance_and_direction(x, y).0
+    }
+
+    /// The signed distance of [`signed_distance_to_point`](Self::signed_distance_to_point) and
+    /// the unit direction in which it grows fastest (away from the boundary outside, towards it
+    /// inside; zero on the boundary itself).
+    pub fn signed_distance_and_direction(&self, x: f64, y: f64) -> (f64, [f64; 2]) {
         let p = Vector::new(x as f32, y as f32);
         let projection = self.shape.project_point(&self.pose, p, false);
-        let d = f64::from((projection.point - p).length());
-        if projection.is_inside { -d } else { d }
+        let away = [
+            f64::from(p.x - projection.point.x),
+            f64::from(p.y - projection.point.y),
+        ];
+        let d = away[0].hypot(away[1]);
+        let sign = if projection.is_inside { -1.0 } else { 1.0 };
+        let direction = if d > 0.0 {
+            [sign * away[0] / d, sign * away[1] / d]
+        } else {
+            [0.0, 0.0]
+        };
+        (sign * d, direction)
     }
 }
 
