@@ -1,12 +1,13 @@
 //! The harmonic field solve: multigrid-preconditioned CG with nested deep-region solves
-//! (`harmonic::solve_w`) against the red-black SOR reference, on the room with two dividers at
+//! (`harmonic::solve_w`; `first-solve` is its first solve alone) against the red-black SOR
+//! reference, on the room with two dividers at
 //! 256² to 2048² cells and on the maze; and a warm-started re-solve after one divider moves by
 //! one cell. Single-threaded. Run with `cargo bench --bench solve`.
 
 use std::path::Path;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use nadf::field::{FreeSpace, harmonic, laplace};
+use nadf::field::{FreeSpace, harmonic, laplace, multigrid};
 use nadf::world::{Override, load};
 
 /// The free space of the first agent of a shipped world, with overrides.
@@ -32,6 +33,18 @@ fn solves(c: &mut Criterion) {
         let s = room(cells, &[]);
         group.bench_with_input(BenchmarkId::new("multigrid", cells), &s, |b, s| {
             b.iter(|| harmonic::solve_w(&s.grid, &s.reachable, s.target_cell, 1e-10, None))
+        });
+        // The first solve alone (to the relative residual of 1e-10 the target names),
+        // without the nested solves that restore relative precision in the deep regions.
+        group.bench_with_input(BenchmarkId::new("first-solve", cells), &s, |b, s| {
+            let t = s.grid.index(s.target_cell.0, s.target_cell.1);
+            let mut unknown = s.reachable.clone();
+            unknown[t] = false;
+            b.iter(|| {
+                let mut w = vec![0.0; s.grid.len()];
+                w[t] = 1.0;
+                multigrid::solve(&s.grid, &unknown, &mut w, 1e-10, harmonic::MAX_ITERATIONS)
+            })
         });
         // The reference only where it finishes in reasonable time.
         if cells <= 512 {

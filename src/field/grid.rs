@@ -57,6 +57,19 @@ impl Grid {
         j * self.nx + i
     }
 
+    /// The 4-neighbours of cell `(i, j)` that are on the grid.
+    pub fn neighbours(&self, i: usize, j: usize) -> impl Iterator<Item = (usize, usize)> {
+        let (nx, ny) = (self.nx, self.ny);
+        [
+            (i.wrapping_sub(1), j),
+            (i + 1, j),
+            (i, j.wrapping_sub(1)),
+            (i, j + 1),
+        ]
+        .into_iter()
+        .filter(move |&(a, b)| a < nx && b < ny)
+    }
+
     /// Centre of cell `(i, j)`, m.
     pub fn center(&self, i: usize, j: usize) -> [f64; 2] {
         [

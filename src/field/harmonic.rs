@@ -1,21 +1,26 @@
 //! The production solve of `W = 1 − V`: multigrid-preconditioned CG ([`multigrid`]), then
 //! nested, rescaled re-solves of the regions where `W` is tiny.
 //!
-//! A solve to a relative residual of 1e-12 gives `W` to about 1e-13 absolute. Behind a few
-//! turns `W` is far smaller than that (1e-17 in a 16 m × 10 m world with three shelves, 1e-60 in
-//! a maze), so the first solution there is noise, and the guidance direction with it. The deep
-//! region `D = {W < τ}` (τ = 1e-6) is therefore solved again on its own: its boundary values —
-//! the neighbouring cells, where `W ≥ τ` is known to full relative precision — are divided by τ,
-//! the problem is solved on `D` alone, and the result multiplied by τ. By the maximum principle
-//! a relative error ε in the boundary values is at most ε relative everywhere inside, so each
-//! level keeps relative precision and reaches six orders of magnitude deeper. This repeats until
-//! no cell is below the current depth: the field never goes flat where a path exists.
+//! A solve to a relative residual of 1e-10 gives `W` to about 1e-12 absolute. Behind a few
+//! turns `W` is far smaller than that (1e-13 in the 10 m room at 1 cm cells, 1e-17 in a
+//! 16 m × 10 m world with three shelves, 1e-140 in the maze), so the first solution there is
+//! noise, and the guidance direction with it. The deep region `D`, the cells below τ = 1e-6
+//! (less those next to a wall, see [`deep_cells`]), is therefore solved again: each connected
+//! part of it on its own, on its bounding box. Its boundary values — the neighbouring cells,
+//! where `W` is known to full relative precision — are divided by τ, the problem is solved on
+//! the part alone, and the result multiplied by τ. By the maximum principle a relative error ε
+//! in the boundary values is at most ε relative everywhere inside, so each level keeps relative
+//! precision and reaches six orders of magnitude deeper. This repeats until no cell is below the
+//! current depth: the field never goes flat where a path exists.
 
 use super::grid::Grid;
 use super::multigrid;
 
 /// The depth gained by each nested solve.
 pub const DEPTH_STEP: f64 = 1e-6;
+/// How many steps through free cells a cell below the depth may be from a cell above it and
+/// still count as resolved (see [`deep_cells`]).
+pub const REACH: usize = 8;
 /// CG iterations allowed per solve.
 pub const MAX_ITERATIONS: usize = 500;
 
@@ -63,44 +68,113 @@ pub fn solve_w(
     };
     let mut depth = DEPTH_STEP;
     while depth > 1e-290 {
-        let deep: Vec<bool> = unknown
-            .iter()
-            .zip(&w)
-            .map(|(u, w)| *u && *w < depth)
-            .collect();
-        let Some(stats) = solve_deep(grid, &deep, &mut w, depth, tolerance) else {
+        let deep = deep_cells(grid, &unknown, &w, depth);
+        let regions = regions(grid, &deep);
+        if regions.is_empty() {
             break;
-        };
-        out.iterations += stats.iterations;
-        out.solves += 1;
-        out.relative_residual = out.relative_residual.max(stats.relative_residual);
+        }
+        for cells in &regions {
+            let stats = solve_deep(grid, cells, &deep, &mut w, depth, tolerance);
+            out.iterations += stats.iterations;
+            out.solves += 1;
+            out.relative_residual = out.relative_residual.max(stats.relative_residual);
+        }
         depth *= DEPTH_STEP;
     }
     out.w = w;
     out
 }
 
-/// Re-solves `W` on the `deep` cells alone, scaled by `1/depth`, with the other cells as
-/// Dirichlet values. Works on the bounding box of the deep cells plus a one-cell margin (which
-/// holds their fixed neighbours), so deeper levels cost less. `None` when no cell is deep.
+/// The cells below `depth` that need a nested solve: those more than [`REACH`] steps through
+/// free cells from any cell at or above it.
+///
+/// A cell next to a wall has a small `W` however close it is to the target, because `W = 0` on
+/// the wall; but so has the solve's error, which is harmonic with the same zero there, so such a
+/// cell is known to the relative precision of the cells a few steps away from the wall.
+/// Counting them as deep would make the nested solves cover every wall of the world. The
+/// distance is counted through free cells: across a wall, a cell's neighbourhood says nothing
+/// about it. (In a corridor one cell wide, the narrowest there is, `W` falls by 2 − √3 per
+/// cell, so `REACH` steps lose at most a factor 3e-5 of relative precision.)
+pub fn deep_cells(grid: &Grid, unknown: &[bool], w: &[f64], depth: f64) -> Vec<bool> {
+    let below = |k: usize| unknown[k] && w[k] < depth;
+    let mut deep: Vec<bool> = (0..grid.len()).map(below).collect();
+    // Breadth-first from the cells below the depth that touch one above it.
+    let mut front = Vec::new();
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            let k = grid.index(i, j);
+            if deep[k]
+                && grid
+                    .neighbours(i, j)
+                    .any(|(a, b)| unknown[grid.index(a, b)] && !below(grid.index(a, b)))
+            {
+                front.push((i, j));
+            }
+        }
+    }
+    for &(i, j) in &front {
+        deep[grid.index(i, j)] = false;
+    }
+    for _ in 1..REACH {
+        let mut next = Vec::new();
+        for &(i, j) in &front {
+            for (a, b) in grid.neighbours(i, j) {
+                let k = grid.index(a, b);
+                if deep[k] {
+                    deep[k] = false;
+                    next.push((a, b));
+                }
+            }
+        }
+        front = next;
+    }
+    deep
+}
+
+/// The connected regions (4-neighbours) of the `deep` cells, each as a list of cell indices.
+fn regions(grid: &Grid, deep: &[bool]) -> Vec<Vec<usize>> {
+    let mut seen = vec![false; grid.len()];
+    let mut regions = Vec::new();
+    for start in 0..grid.len() {
+        if !deep[start] || seen[start] {
+            continue;
+        }
+        seen[start] = true;
+        let mut cells = vec![start];
+        let mut next = 0;
+        while next < cells.len() {
+            let k = cells[next];
+            next += 1;
+            for (a, b) in grid.neighbours(k % grid.nx, k / grid.nx) {
+                let m = grid.index(a, b);
+                if deep[m] && !seen[m] {
+                    seen[m] = true;
+                    cells.push(m);
+                }
+            }
+        }
+        regions.push(cells);
+    }
+    regions
+}
+
+/// Re-solves `W` on one connected region of deep cells, scaled by `1/depth`, with the cells
+/// around it as Dirichlet values. Works on the region's bounding box plus a one-cell margin
+/// (which holds their fixed neighbours), so small regions and deeper levels cost little. Other
+/// regions inside the box are not its neighbours, so their values do not matter.
 fn solve_deep(
     grid: &Grid,
+    cells: &[usize],
     deep: &[bool],
     w: &mut [f64],
     depth: f64,
     tolerance: f64,
-) -> Option<multigrid::Stats> {
+) -> multigrid::Stats {
     let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
-    for j in 0..grid.ny {
-        for i in 0..grid.nx {
-            if deep[grid.index(i, j)] {
-                lo = [lo[0].min(i), lo[1].min(j)];
-                hi = [hi[0].max(i), hi[1].max(j)];
-            }
-        }
-    }
-    if lo[0] == usize::MAX {
-        return None;
+    for &k in cells {
+        let (i, j) = (k % grid.nx, k / grid.nx);
+        lo = [lo[0].min(i), lo[1].min(j)];
+        hi = [hi[0].max(i), hi[1].max(j)];
     }
     let (i0, j0) = (lo[0].saturating_sub(1), lo[1].saturating_sub(1));
     let (i1, j1) = ((hi[0] + 1).min(grid.nx - 1), (hi[1] + 1).min(grid.ny - 1));
@@ -110,31 +184,55 @@ fn solve_deep(
         cell: grid.cell,
         origin: grid.center(i0, j0).map(|c| c - 0.5 * grid.cell),
     };
-    let mut sub_deep = vec![false; sub.len()];
+    let mut unknown = vec![false; sub.len()];
+    for &k in cells {
+        unknown[sub.index(k % grid.nx - i0, k / grid.nx - j0)] = true;
+    }
     let mut scaled = vec![0.0; sub.len()];
     for j in 0..sub.ny {
-        for i in 0..sub.nx {
-            let (k, s) = (grid.index(i0 + i, j0 + j), sub.index(i, j));
-            sub_deep[s] = deep[k];
-            scaled[s] = w[k].max(0.0) / depth;
+        let row = grid.index(i0, j0 + j);
+        for (i, v) in scaled[j * sub.nx..(j + 1) * sub.nx].iter_mut().enumerate() {
+            // Deep cells of other regions are never next to this one; 0 keeps them harmless.
+            let k = row + i;
+            *v = if deep[k] && !unknown[j * sub.nx + i] {
+                0.0
+            } else {
+                w[k].max(0.0) / depth
+            };
         }
     }
-    let stats = multigrid::solve(&sub, &sub_deep, &mut scaled, tolerance, MAX_ITERATIONS);
-    for j in 0..sub.ny {
-        for i in 0..sub.nx {
-            let s = sub.index(i, j);
-            if sub_deep[s] {
-                w[grid.index(i0 + i, j0 + j)] = scaled[s] * depth;
-            }
-        }
+    let stats = multigrid::solve(&sub, &unknown, &mut scaled, tolerance, MAX_ITERATIONS);
+    for &k in cells {
+        w[k] = scaled[sub.index(k % grid.nx - i0, k / grid.nx - j0)] * depth;
     }
-    Some(stats)
+    stats
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::field::laplace::reachable_from;
+
+    /// Cells below the depth next to a shallow cell are resolved (a wall's neighbours), cells
+    /// more than `REACH` steps in are deep, and reach does not cross a wall.
+    #[test]
+    fn deep_cells_lie_beyond_reach_of_the_shallow_ones() {
+        let grid = Grid::covering([3.0, 0.1], 0.1);
+        assert_eq!((grid.nx, grid.ny), (30, 1));
+        let mut unknown = vec![true; grid.len()];
+        unknown[20] = false; // a wall
+        // Shallow cells 0..5, then tiny values along the row, and behind the wall.
+        let w: Vec<f64> = (0..30).map(|i| if i < 5 { 0.5 } else { 1e-9 }).collect();
+        let deep = deep_cells(&grid, &unknown, &w, 1e-6);
+        for (i, deep) in deep.iter().enumerate() {
+            assert_eq!(*deep, i >= 5 + REACH && i != 20, "cell {i}");
+        }
+        // Two separate regions: either side of the wall.
+        let regions = regions(&grid, &deep);
+        assert_eq!(regions.len(), 2);
+        assert_eq!(regions[0], (5 + REACH..20).collect::<Vec<_>>());
+        assert_eq!(regions[1], (21..30).collect::<Vec<_>>());
+    }
 
     /// A long corridor: `W` decays by about e^(−π) per corridor width, to far below what one
     /// solve resolves. Every cell still gets a positive `W` that decreases along the corridor.

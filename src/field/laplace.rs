@@ -65,19 +65,11 @@ pub fn reachable_from(grid: &Grid, blocked: &[bool], start: (usize, usize)) -> V
     seen[s] = true;
     let mut stack = vec![start];
     while let Some((i, j)) = stack.pop() {
-        let neighbours = [
-            (i.wrapping_sub(1), j),
-            (i + 1, j),
-            (i, j.wrapping_sub(1)),
-            (i, j + 1),
-        ];
-        for (a, b) in neighbours {
-            if a < grid.nx && b < grid.ny {
-                let k = grid.index(a, b);
-                if !blocked[k] && !seen[k] {
-                    seen[k] = true;
-                    stack.push((a, b));
-                }
+        for (a, b) in grid.neighbours(i, j) {
+            let k = grid.index(a, b);
+            if !blocked[k] && !seen[k] {
+                seen[k] = true;
+                stack.push((a, b));
             }
         }
     }
