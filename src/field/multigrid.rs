@@ -581,14 +581,20 @@ fn apply_fine(level: &Level, p: &[f64], y: &mut [f64]) -> f64 {
     )
 }
 
-/// `out = r · scale` in f32, with values too small for f32 to hold at full precision set to 0.
+/// `r · scale` rounded to f32 for the cycle, 0 when too small for f32 to hold at full precision.
+#[inline(always)]
+fn for_cycle(r: f64, scale: f64) -> f32 {
+    let v = (r * scale) as f32;
+    if v.abs() < FLUSH { 0.0 } else { v }
+}
+
+/// `out = r · scale` in f32 for the cycle ([`for_cycle`]).
 fn to_f32(r: &[f64], scale: f64, out: &mut [f32]) {
     wide(
         #[inline(always)]
         || {
             for (o, r) in out.iter_mut().zip(r) {
-                let v = (r * scale) as f32;
-                *o = if v.abs() < FLUSH { 0.0 } else { v };
+                *o = for_cycle(*r, scale);
             }
         },
     )
@@ -606,8 +612,7 @@ fn update_residual(r: &mut [f64], ap: &[f64], alpha: f64, scale: f64, out: &mut 
                 for l in 0..4 {
                     r[l] -= alpha * ap[l];
                     sums[l] += r[l] * r[l];
-                    let v = (r[l] * scale) as f32;
-                    o[l] = if v.abs() < FLUSH { 0.0 } else { v };
+                    o[l] = for_cycle(r[l], scale);
                 }
             }
             let tail = r.len() / 4 * 4;
@@ -615,8 +620,7 @@ fn update_residual(r: &mut [f64], ap: &[f64], alpha: f64, scale: f64, out: &mut 
             for k in tail..r.len() {
                 r[k] -= alpha * ap[k];
                 rest += r[k] * r[k];
-                let v = (r[k] * scale) as f32;
-                out[k] = if v.abs() < FLUSH { 0.0 } else { v };
+                out[k] = for_cycle(r[k], scale);
             }
             (sums[0] + sums[1]) + (sums[2] + sums[3]) + rest
         },
