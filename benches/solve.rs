@@ -80,28 +80,19 @@ fn solves(c: &mut Criterion) {
     )
     .w;
     let after = room(512, &[format!("walls.1.center.0={}", 6.75 + 10.0 / 512.0)]);
-    group.bench_function("cold", |b| {
-        b.iter(|| {
-            harmonic::solve_w(
-                &after.grid,
-                &after.reachable,
-                after.target_cell,
-                1e-10,
-                None,
-            )
-        })
-    });
-    group.bench_function("warm", |b| {
-        b.iter(|| {
-            harmonic::solve_w(
-                &after.grid,
-                &after.reachable,
-                after.target_cell,
-                1e-10,
-                Some(&old),
-            )
-        })
-    });
+    for (name, warm) in [("cold", None), ("warm", Some(old.as_slice()))] {
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                harmonic::solve_w(
+                    &after.grid,
+                    &after.reachable,
+                    after.target_cell,
+                    1e-10,
+                    warm,
+                )
+            })
+        });
+    }
     group.finish();
 }
 

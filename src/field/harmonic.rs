@@ -74,7 +74,7 @@ pub fn solve_w(
             break;
         }
         for cells in &regions {
-            let stats = solve_deep(grid, cells, &deep, &mut w, depth, tolerance);
+            let stats = solve_deep(grid, cells, &mut w, depth, tolerance);
             out.iterations += stats.iterations;
             out.solves += 1;
             out.relative_residual = out.relative_residual.max(stats.relative_residual);
@@ -165,7 +165,6 @@ fn regions(grid: &Grid, deep: &[bool]) -> Vec<Vec<usize>> {
 fn solve_deep(
     grid: &Grid,
     cells: &[usize],
-    deep: &[bool],
     w: &mut [f64],
     depth: f64,
     tolerance: f64,
@@ -192,13 +191,7 @@ fn solve_deep(
     for j in 0..sub.ny {
         let row = grid.index(i0, j0 + j);
         for (i, v) in scaled[j * sub.nx..(j + 1) * sub.nx].iter_mut().enumerate() {
-            // Deep cells of other regions are never next to this one; 0 keeps them harmless.
-            let k = row + i;
-            *v = if deep[k] && !unknown[j * sub.nx + i] {
-                0.0
-            } else {
-                w[k].max(0.0) / depth
-            };
+            *v = w[row + i].max(0.0) / depth;
         }
     }
     let stats = multigrid::solve(&sub, &unknown, &mut scaled, tolerance, MAX_ITERATIONS);
