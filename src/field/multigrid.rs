@@ -24,7 +24,13 @@
 //! residual restriction (or its prolongation and smoothing passes) run as one wavefront over the
 //! rows, so a level is read from memory once per half-cycle rather than once per pass; every
 //! row loop is straight-line code that the compiler vectorizes, built for AVX2 when the
-//! processor has it (`wide`); and the CG vector updates are fused into three passes.
+//! processor has it (`wide`); and each CG iteration makes two passes over its vectors besides
+//! the cycle (`Krylov`): one makes the new search direction and its curvature `p · A p`, the
+//! other updates the solution and the residual. The search direction is kept in f32, scaled
+//! like the cycle's output it is made from, and `A p` is recomputed from it rather than stored:
+//! the solution and the residual, in f64, take the same exact steps, so rounding the direction
+//! only changes which direction CG takes (by 1e-7, as the f32 cycle already does) and never
+//! lets the residual drift from `b − A x`.
 //!
 //! The initial values of the unknown cells are the starting guess: a warm start from a previous
 //! solution makes a re-solve after a small change cheaper, though not by much, since CG still
@@ -255,17 +261,31 @@ impl Level {
         x[k..k + n].copy_from_slice(t);
     }
 
+    /// [`Level::relax_row`] when `x` is 0: `x = b / diagonal` on colour `c`, 0 elsewhere. It
+    /// reads nothing of `x`, so a cycle that starts from 0 need not clear it first.
+    #[inline(always)]
+    fn relax_row_from_zero(&self, c: usize, j: usize, x: &mut [f32], b: &[f32], keep: &Keep) {
+        let n = self.nx;
+        let k = self.pad(0, j);
+        let keep = &keep[(c + j) % 2][..n];
+        let (x, b, d) = (&mut x[k..k + n], &b[k..k + n], &self.inv_diag[k..k + n]);
+        for i in 0..n {
+            x[i] = (1.0 - keep[i]) * d[i] * b[i];
+        }
+    }
+
     /// The Gauss-Seidel passes `colours` (one colour each, in order) over the whole level, as a
     /// wavefront: at step `s`, pass `p` updates row `s − p`. That is exactly the passes one
     /// after another (a row's update reads only rows beside it, which every earlier pass has
     /// already updated and no later pass has touched yet), but the rows in flight stay in
     /// cache, so the level is read from memory once instead of once per pass. `before(r)` runs
     /// before any pass reads row `r`; `after(r)` once every pass is done with rows `r − 1`,
-    /// `r` and `r + 1`.
+    /// `r` and `r + 1`. With `zero_start`, the first pass takes `x` as 0, whatever it holds.
     #[inline(always)]
     fn sweep(
         &self,
         colours: &[usize],
+        zero_start: bool,
         (x, b): (&mut [f32], &[f32]),
         (t, keep): (&mut [f32], &Keep),
         mut before: impl FnMut(usize, &mut [f32]),
@@ -281,7 +301,11 @@ impl Level {
             }
             for (p, &c) in colours.iter().enumerate() {
                 if let Some(j) = step.checked_sub(p).filter(|&j| j < self.ny) {
-                    self.relax_row(c, j, x, b, t, keep);
+                    if p == 0 && zero_start {
+                        self.relax_row_from_zero(c, j, x, b, keep);
+                    } else {
+                        self.relax_row(c, j, x, b, t, keep);
+                    }
                 }
             }
             if let Some(j) = step.checked_sub(passes).filter(|&j| j < self.ny) {
@@ -457,36 +481,34 @@ impl Hierarchy {
     }
 
     /// `z ≈ A⁻¹ r`: one cycle from a zero guess. The fine right-hand side is `work[0][1]`,
-    /// which the caller fills; the result is left in `work[0][0]`.
-    fn precondition(&mut self) {
-        self.work[0][0].fill(0.0);
-        self.cycle(0);
+    /// which the caller fills; the result is left in `work[0][0]`. Returns `z · r`.
+    fn precondition(&mut self) -> f64 {
+        self.cycle(0, true)
     }
 
-    /// One cycle on level `l`, from the current `x` of that level.
-    fn cycle(&mut self, l: usize) {
+    /// One cycle on level `l`, from 0 (`zero_start`, whatever `x` holds) or from the current
+    /// `x` of that level; returns `x · b` of the result.
+    fn cycle(&mut self, l: usize, zero_start: bool) -> f64 {
         if l + 1 == self.levels.len() {
             let [x, b] = &mut self.work[l];
             self.coarsest.solve(x, b, &mut self.scratch);
-            return;
+            return dot(x, b);
         }
-        self.smooth_and_restrict(l);
-        for _ in 0..VISITS {
-            self.cycle(l + 1);
+        self.smooth_and_restrict(l, zero_start);
+        for visit in 0..VISITS {
+            self.cycle(l + 1, visit == 0);
         }
-        self.prolong_and_smooth(l);
+        self.prolong_and_smooth(l)
     }
 
     /// Pre-smoothing on level `l` (red then black, `SWEEPS` times), then its residual summed
-    /// into level `l + 1`'s right-hand side (each coarse cell sums its children's), with a zero
-    /// guess there. One wavefront does it all.
-    fn smooth_and_restrict(&mut self, l: usize) {
+    /// into level `l + 1`'s right-hand side (each coarse cell sums its children's). One
+    /// wavefront does it all.
+    fn smooth_and_restrict(&mut self, l: usize, zero_start: bool) {
         let (fine_work, coarse_work) = self.work.split_at_mut(l + 1);
         let [x, b] = &mut fine_work[l];
         let (level, coarse) = (&self.levels[l], &self.levels[l + 1]);
-        let [coarse_x, coarse_b] = &mut coarse_work[0];
-        coarse_b.fill(0.0);
-        coarse_x.fill(0.0);
+        let coarse_b = &mut coarse_work[0][1];
         let (t, residual, keep) = (&mut self.row, &mut self.residual, &self.keep);
         let colours = [[0, 1]; SWEEPS];
         let colours = colours.as_flattened();
@@ -495,6 +517,7 @@ impl Hierarchy {
             || {
                 level.sweep(
                     colours,
+                    zero_start,
                     (x, b),
                     (t, keep),
                     |_, _| {},
@@ -504,13 +527,15 @@ impl Hierarchy {
                         level.residual_row(j, x, b, residual);
                         let base = coarse.pad(0, j / 2);
                         let parents = &mut coarse_b[base..base + level.nx.div_ceil(2)];
+                        // The even row of a pair sets its parents, the odd one adds to them.
+                        let first = if j % 2 == 0 { 0.0 } else { 1.0 };
                         let pairs = residual.chunks_exact(2);
                         if let (Some(r), Some(c)) = (pairs.remainder().first(), parents.last_mut())
                         {
-                            *c += r;
+                            *c = first * *c + r;
                         }
                         for (c, r) in parents.iter_mut().zip(pairs) {
-                            *c += r[0] + r[1];
+                            *c = first * *c + (r[0] + r[1]);
                         }
                     },
                 )
@@ -519,8 +544,9 @@ impl Hierarchy {
     }
 
     /// Every active cell of level `l` gets its coarse cell's correction; then post-smoothing
-    /// (black then red, `SWEEPS` times). One wavefront does it all.
-    fn prolong_and_smooth(&mut self, l: usize) {
+    /// (black then red, `SWEEPS` times). One wavefront does it all. Returns `x · b` on the
+    /// finest level (CG needs it, and each row is still in cache when it is final), else 0.
+    fn prolong_and_smooth(&mut self, l: usize) -> f64 {
         let (level, coarse) = (&self.levels[l], &self.levels[l + 1]);
         let (fine_work, coarse_work) = self.work.split_at_mut(l + 1);
         let [x, b] = &mut fine_work[l];
@@ -529,11 +555,13 @@ impl Hierarchy {
         let colours = [[1, 0]; SWEEPS];
         let colours = colours.as_flattened();
         let n = level.nx;
+        let mut xb = 0.0;
         wide(
             #[inline(always)]
             || {
                 level.sweep(
                     colours,
+                    false,
                     (x, b),
                     (t, keep),
                     #[inline(always)]
@@ -551,34 +579,58 @@ impl Hierarchy {
                             *x += if *a != 0.0 { *c } else { 0.0 };
                         }
                     },
-                    |_, _| {},
+                    #[inline(always)]
+                    |j, x| {
+                        if l == 0 {
+                            let k = level.pad(0, j);
+                            xb += dot(&x[k..k + n], &b[k..k + n]);
+                        }
+                    },
                 )
             },
         );
+        xb
     }
 }
 
-/// `y = A p` on the fine level, in f64, and `p · A p`.
-fn apply_fine(level: &Level, p: &[f64], y: &mut [f64]) -> f64 {
-    wide(
-        #[inline(always)]
-        || {
-            let (n, s) = (level.nx, level.stride);
-            let mut pap = 0.0;
-            for j in 0..level.ny {
-                let k = level.pad(0, j);
-                let (mid, west, east) = (&p[k..k + n], &p[k - 1..k - 1 + n], &p[k + 1..k + 1 + n]);
-                let (up, down) = (&p[k + s..k + s + n], &p[k - s..k - s + n]);
-                let (d, y) = (&level.inv_diag[k..k + n], &mut y[k..k + n]);
-                for i in 0..n {
-                    let ap = 4.0 * mid[i] - west[i] - east[i] - up[i] - down[i];
-                    y[i] = if d[i] != 0.0 { ap } else { 0.0 };
-                }
-                pap += dot(mid, y);
-            }
-            pap
-        },
-    )
+/// `A q` on row `j` of the fine level, in f64, into `out`: the 5-point stencil on every cell,
+/// so it is `A q` on the active cells only (`q` is 0 on the others). `q` holds f32 values, so
+/// the sums are exact in f64.
+#[inline(always)]
+fn apply_row(level: &Level, q: &[f32], j: usize, out: &mut [f64]) {
+    let (n, s) = (level.nx, level.stride);
+    let k = level.pad(0, j);
+    let (mid, west, east) = (&q[k..k + n], &q[k - 1..k - 1 + n], &q[k + 1..k + 1 + n]);
+    let (up, down) = (&q[k + s..k + s + n], &q[k - s..k - s + n]);
+    let out = &mut out[..n];
+    for i in 0..n {
+        out[i] = 4.0 * f64::from(mid[i])
+            - f64::from(west[i])
+            - f64::from(east[i])
+            - f64::from(up[i])
+            - f64::from(down[i]);
+    }
+}
+
+/// `a · b` in f64 (either may hold f32), summed in four interleaved partial sums (a fixed
+/// order, so the result does not depend on the machine) that the compiler can keep in vector
+/// registers.
+#[inline(always)]
+fn dot<A: Copy + Into<f64>, B: Copy + Into<f64>>(a: &[A], b: &[B]) -> f64 {
+    let mut sums = [0.0; 4];
+    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = a4
+        .remainder()
+        .iter()
+        .zip(b4.remainder())
+        .map(|(x, y)| (*x).into() * (*y).into())
+        .sum();
+    for (a, b) in a4.zip(b4) {
+        for l in 0..4 {
+            sums[l] += a[l].into() * b[l].into();
+        }
+    }
+    (sums[0] + sums[1]) + (sums[2] + sums[3]) + tail
 }
 
 /// `r · scale` rounded to f32 for the cycle, 0 when too small for f32 to hold at full precision.
@@ -588,105 +640,71 @@ fn for_cycle(r: f64, scale: f64) -> f32 {
     if v.abs() < FLUSH { 0.0 } else { v }
 }
 
-/// `out = r · scale` in f32 for the cycle ([`for_cycle`]).
-fn to_f32(r: &[f64], scale: f64, out: &mut [f32]) {
-    wide(
-        #[inline(always)]
-        || {
-            for (o, r) in out.iter_mut().zip(r) {
-                *o = for_cycle(*r, scale);
-            }
-        },
-    )
+/// The CG vectors on the fine level's padded layout. The search direction is kept in f32 as
+/// `q = p / σ`, scaled like the cycle's output it is made from (see [`solve`]); the solution
+/// `x` and the residual `r` stay in f64, since they carry the solution's precision.
+struct Krylov {
+    x: Vec<f64>,
+    r: Vec<f64>,
+    q: Vec<f32>,
+    /// One row of `A q`.
+    row: Vec<f64>,
 }
 
-/// The CG residual update `r −= α A p`, its new `r · r`, and `out = r · scale` in f32 (the
-/// next cycle's right-hand side): one pass.
-fn update_residual(r: &mut [f64], ap: &[f64], alpha: f64, scale: f64, out: &mut [f32]) -> f64 {
-    wide(
-        #[inline(always)]
-        || {
-            let mut sums = [0.0; 4];
-            let chunks = r.chunks_exact_mut(4).zip(ap.chunks_exact(4));
-            for ((r, ap), o) in chunks.zip(out.chunks_exact_mut(4)) {
-                for l in 0..4 {
-                    r[l] -= alpha * ap[l];
-                    sums[l] += r[l] * r[l];
-                    o[l] = for_cycle(r[l], scale);
+impl Krylov {
+    /// The new direction `q = z + γ q` and its curvature `q · A q`: one pass, `A q` trailing a
+    /// row behind the rows it reads. (`q` is 0 on inactive cells, so they add nothing to the
+    /// sum whatever the stencil gives there.)
+    fn direct(&mut self, level: &Level, z: &[f32], gamma: f32) -> f64 {
+        let Self { q, row, .. } = self;
+        wide(
+            #[inline(always)]
+            || {
+                let n = level.nx;
+                let mut qaq = 0.0;
+                for j in 0..level.ny + 1 {
+                    if j < level.ny {
+                        let k = level.pad(0, j);
+                        for (q, z) in q[k..k + n].iter_mut().zip(&z[k..k + n]) {
+                            *q = z + gamma * *q;
+                        }
+                    }
+                    if j > 0 {
+                        apply_row(level, q, j - 1, row);
+                        let k = level.pad(0, j - 1);
+                        qaq += dot(&q[k..k + n], &row[..n]);
+                    }
                 }
-            }
-            let tail = r.len() / 4 * 4;
-            let mut rest = 0.0;
-            for k in tail..r.len() {
-                r[k] -= alpha * ap[k];
-                rest += r[k] * r[k];
-                out[k] = for_cycle(r[k], scale);
-            }
-            (sums[0] + sums[1]) + (sums[2] + sums[3]) + rest
-        },
-    )
-}
-
-/// The CG step `x += α p` then the new direction `p = z · unscale + β p` (skipped when `β` is
-/// NaN, after the last iteration): one pass.
-fn step(x: &mut [f64], p: &mut [f64], z: &[f32], alpha: f64, beta: f64, unscale: f64) {
-    wide(
-        #[inline(always)]
-        || {
-            if beta.is_nan() {
-                for (x, p) in x.iter_mut().zip(p.iter()) {
-                    *x += alpha * p;
-                }
-                return;
-            }
-            for ((x, p), z) in x.iter_mut().zip(p.iter_mut()).zip(z) {
-                *x += alpha * *p;
-                *p = f64::from(*z) * unscale + beta * *p;
-            }
-        },
-    )
-}
-
-/// `z · r` with `z` in f32, in four partial sums like [`dot`].
-fn dot_f32(z: &[f32], r: &[f64]) -> f64 {
-    wide(
-        #[inline(always)]
-        || {
-            let mut sums = [0.0; 4];
-            let (z4, r4) = (z.chunks_exact(4), r.chunks_exact(4));
-            let tail: f64 = z4
-                .remainder()
-                .iter()
-                .zip(r4.remainder())
-                .map(|(z, r)| f64::from(*z) * r)
-                .sum();
-            for (z, r) in z4.zip(r4) {
-                for l in 0..4 {
-                    sums[l] += f64::from(z[l]) * r[l];
-                }
-            }
-            (sums[0] + sums[1]) + (sums[2] + sums[3]) + tail
-        },
-    )
-}
-
-/// `a · b`, summed in four interleaved partial sums (a fixed order, so the result does not
-/// depend on the machine) that the compiler can keep in vector registers.
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut sums = [0.0; 4];
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = a4
-        .remainder()
-        .iter()
-        .zip(b4.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (a, b) in a4.zip(b4) {
-        for l in 0..4 {
-            sums[l] += a[l] * b[l];
-        }
+                qaq
+            },
+        )
     }
-    (sums[0] + sums[1]) + (sums[2] + sums[3]) + tail
+
+    /// The step `x += c q`, `r −= c A q` (on the active cells), the new `r · r`, and
+    /// `out = r · scale` in f32 (the next cycle's right-hand side): one pass.
+    fn step(&mut self, level: &Level, c: f64, scale: f64, out: &mut [f32]) -> f64 {
+        let Self { x, r, q, row } = self;
+        wide(
+            #[inline(always)]
+            || {
+                let n = level.nx;
+                let mut rr = 0.0;
+                for j in 0..level.ny {
+                    apply_row(level, q, j, row);
+                    let k = level.pad(0, j);
+                    let (x, r, q) = (&mut x[k..k + n], &mut r[k..k + n], &q[k..k + n]);
+                    let (d, out) = (&level.inv_diag[k..k + n], &mut out[k..k + n]);
+                    for i in 0..n {
+                        x[i] += c * f64::from(q[i]);
+                        r[i] -= if d[i] != 0.0 { c * row[i] } else { 0.0 };
+                        out[i] = for_cycle(r[i], scale);
+                    }
+                    rr += dot(r, r);
+                }
+                rr
+            },
+        )
+    }
 }
 
 /// Solves `∇²u = 0` on the `unknown` cells of `grid`, with the other cells of `values` as
@@ -704,10 +722,9 @@ pub fn solve(
     let fine = &h.levels[0];
     let n = fine.len();
     let (nx, ny, stride) = (grid.nx, grid.ny, fine.stride);
-    // x: the starting guess; b: the sum of the fixed neighbours of every unknown (cells
-    // outside the grid are the ring of zeros around `fixed`). `fixed` is then reused for the
-    // residual and `b` for the search direction: fresh memory costs page faults.
-    let mut b = vec![0.0; n];
+    // x: the starting guess; `fixed`: the Dirichlet values (cells outside the grid are its ring
+    // of zeros), whose sum around each unknown is the right-hand side b. `fixed` then becomes
+    // the residual: fresh memory costs page faults.
     let mut x = vec![0.0; n];
     let mut fixed = vec![0.0; n];
     for j in 0..ny {
@@ -721,20 +738,45 @@ pub fn solve(
             (*x, *f) = if *u { (*v, 0.0) } else { (0.0, *v) };
         }
     }
-    for j in 0..ny {
-        let k = fine.pad(0, j);
-        let (west, east) = (&fixed[k - 1..k - 1 + nx], &fixed[k + 1..k + 1 + nx]);
-        let (up, down) = (
-            &fixed[k + stride..k + stride + nx],
-            &fixed[k - stride..k - stride + nx],
-        );
-        let d = &fine.inv_diag[k..k + nx];
-        for (i, b) in b[k..k + nx].iter_mut().enumerate() {
-            let sum = west[i] + east[i] + up[i] + down[i];
-            *b = if d[i] != 0.0 { sum } else { 0.0 };
+    // r = b − A x row by row, trailing two rows behind so that `fixed` (read up to a row ahead)
+    // can be overwritten with r.
+    let (mut bb, mut rr) = (0.0, 0.0);
+    let mut rows = [vec![0.0; nx], vec![0.0; nx]];
+    for j in 0..ny + 2 {
+        if j >= 2 {
+            let k = fine.pad(0, j - 2);
+            fixed[k..k + nx].copy_from_slice(&rows[j % 2]);
+        }
+        if j < ny {
+            let k = fine.pad(0, j);
+            let (west, east) = (&fixed[k - 1..k - 1 + nx], &fixed[k + 1..k + 1 + nx]);
+            let (up, down) = (
+                &fixed[k + stride..k + stride + nx],
+                &fixed[k - stride..k - stride + nx],
+            );
+            let (mid, xw, xe) = (&x[k..k + nx], &x[k - 1..k - 1 + nx], &x[k + 1..k + 1 + nx]);
+            let (xu, xd) = (
+                &x[k + stride..k + stride + nx],
+                &x[k - stride..k - stride + nx],
+            );
+            let d = &fine.inv_diag[k..k + nx];
+            let row = &mut rows[j % 2];
+            let mut b_row = 0.0;
+            for i in 0..nx {
+                let (b, r) = if d[i] != 0.0 {
+                    let b = west[i] + east[i] + up[i] + down[i];
+                    (b, b - (4.0 * mid[i] - xw[i] - xe[i] - xu[i] - xd[i]))
+                } else {
+                    (0.0, 0.0)
+                };
+                b_row += b * b;
+                row[i] = r;
+            }
+            bb += b_row;
+            rr += dot(row, row);
         }
     }
-    let norm_b = dot(&b, &b).sqrt();
+    let norm_b = bb.sqrt();
     let relative = |rr: f64| {
         if norm_b > 0.0 {
             rr.sqrt() / norm_b
@@ -742,54 +784,53 @@ pub fn solve(
             rr.sqrt()
         }
     };
-    let mut r = fixed;
-    apply_fine(fine, &x, &mut r);
-    for (r, b) in r.iter_mut().zip(&b) {
-        *r = b - *r;
-    }
-    let mut rr = dot(&r, &r);
     let mut stats = Stats {
         iterations: 0,
         relative_residual: relative(rr),
     };
-    let mut p = b;
-    let mut ap = vec![0.0; n];
-    // The cycle's right-hand side is r scaled to about unit norm (by the last known ‖r‖),
-    // so f32 sees no extreme values; `unscale` undoes it on the cycle's result z.
-    let mut scale = if rr > 0.0 { 1.0 / rr.sqrt() } else { 1.0 };
+    let mut cg = Krylov {
+        x,
+        r: fixed,
+        q: vec![0.0; n],
+        row: vec![0.0; nx],
+    };
+    // Preconditioned CG (z = M r, p = z + β p, x += α p, r −= α A p, α = r·z / p·A p,
+    // β = r_next·z_next / r·z), with the cycle's right-hand side r scaled by `scale`, about
+    // 1 / ‖r‖, so that f32 sees no extreme values. The cycle then returns `scale · z`, and the
+    // direction is kept as `q = scale · p`, which is also O(1): `p · A p = q · A q / scale²`,
+    // and the next `q = scale' · z' + β (scale' / scale) q`.
     if stats.relative_residual > tolerance {
-        to_f32(&r, scale, &mut h.work[0][1]);
-        h.precondition();
-        let mut rz = dot_f32(&h.work[0][0], &r) / scale;
-        step(&mut x, &mut p, &h.work[0][0], 0.0, 0.0, 1.0 / scale);
+        let mut scale = 1.0 / rr.sqrt();
+        wide(|| {
+            for (o, r) in h.work[0][1].iter_mut().zip(&cg.r) {
+                *o = for_cycle(*r, scale);
+            }
+        });
+        let mut rz = h.precondition() / (scale * scale);
+        let mut gamma = 0.0;
         while stats.iterations < max_iterations {
             stats.iterations += 1;
-            let pap = apply_fine(&h.levels[0], &p, &mut ap);
+            let pap = cg.direct(&h.levels[0], &h.work[0][0], gamma) / (scale * scale);
             if pap.is_nan() || pap <= 0.0 {
                 break;
             }
             let alpha = rz / pap;
-            rr = update_residual(&mut r, &ap, alpha, scale, &mut h.work[0][1]);
+            let next_scale = 1.0 / rr.sqrt();
+            rr = cg.step(&h.levels[0], alpha / scale, next_scale, &mut h.work[0][1]);
             stats.relative_residual = relative(rr);
             if stats.relative_residual <= tolerance {
-                step(&mut x, &mut p, &h.work[0][0], alpha, f64::NAN, 0.0);
                 break;
             }
-            h.precondition();
-            let rz_next = dot_f32(&h.work[0][0], &r) / scale;
-            let beta = rz_next / rz;
-            rz = rz_next;
-            step(&mut x, &mut p, &h.work[0][0], alpha, beta, 1.0 / scale);
-            if rr > 0.0 {
-                scale = 1.0 / rr.sqrt();
-            }
+            let rz_next = h.precondition() / (next_scale * next_scale);
+            gamma = (rz_next / rz * next_scale / scale) as f32;
+            (rz, scale) = (rz_next, next_scale);
         }
     }
     for j in 0..ny {
         let (k, row) = (h.levels[0].pad(0, j), j * nx..(j + 1) * nx);
         for ((v, x), u) in values[row.clone()]
             .iter_mut()
-            .zip(&x[k..k + nx])
+            .zip(&cg.x[k..k + nx])
             .zip(&unknown[row])
         {
             if *u {
