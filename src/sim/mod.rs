@@ -10,6 +10,8 @@
 //! With several agents, each one's field has the others as obstacles (discs grown by both
 //! radii): a harmonic field is re-solved at `field.replan_hz` with the others where they are
 //! then, warm-started from the last solve; an attractive-repulsive one sees them at every step.
+//! The agents whose fields are due are re-solved in parallel (rayon), after every agent's state
+//! and sensor reading have been taken in order, so a run does not depend on the threads.
 //! A noisy sensor rebuilds the field from each reading. A rebuild that fails (the others or the
 //! sensed walls cut the agent off) keeps the last field and logs a note once.
 
@@ -22,6 +24,7 @@ use std::collections::HashSet;
 
 use nalgebra::Vector2;
 use rapier2d::prelude::{ColliderHandle, PhysicsWorld, RigidBodyHandle};
+use rayon::prelude::*;
 
 pub use physics::{from_rapier, to_rapier};
 pub use sensor::Sensor;
@@ -61,6 +64,19 @@ pub struct AgentRun {
     rebuild_failed: bool,
     offsets: Vec<f64>,
     replans: usize,
+}
+
+/// One agent's part of a step, read before any field is re-solved.
+struct Plan {
+    /// Position and velocity at the start of the step.
+    x: Vector2<f64>,
+    v: Vector2<f64>,
+    /// Whether its sensor took a reading this step.
+    sensed_now: bool,
+    /// The other agents' discs.
+    others: Vec<Disc>,
+    /// Whether its harmonic field is re-solved this step.
+    resolve: bool,
 }
 
 /// What happened to one agent in the last step, for recording.
@@ -213,71 +229,100 @@ impl Simulation {
                 }
             })
             .collect();
-        for (index, (((run, events), notes), sensed)) in self
-            .agents
-            .iter_mut()
-            .zip(&mut events)
-            .zip(&mut notes)
-            .zip(&mut sensed)
-            .enumerate()
-        {
-            let body = &mut self.physics.bodies[run.body];
-            let x = from_rapier(body.translation());
-            let v = from_rapier(body.linvel());
-            let mut control = None;
+        // First, in agent order: each agent's state, its sensor reading and whether its
+        // harmonic field is due for a re-solve.
+        let mut plans = Vec::with_capacity(self.agents.len());
+        for (index, (run, events)) in self.agents.iter_mut().zip(&mut events).enumerate() {
+            let body = &self.physics.bodies[run.body];
+            let (x, v) = (from_rapier(body.translation()), from_rapier(body.linvel()));
             if !run.frozen && !(x.iter().chain(v.iter()).all(|c| c.is_finite())) {
                 run.frozen = true;
                 events.extend(run.faults.non_finite_state());
             }
+            let mut plan = Plan {
+                x,
+                v,
+                sensed_now: false,
+                others: Vec::new(),
+                resolve: false,
+            };
             if !run.frozen {
-                let sensed_now = match &mut run.sensor {
+                plan.sensed_now = match &mut run.sensor {
                     Some(sensor) if sensor.due(self.time) => {
                         run.offsets = sensor.read(self.walls.len());
                         true
                     }
                     _ => false,
                 };
-                let others = others_than(&discs, index);
-                let replan_due = !others.is_empty()
+                plan.others = others_than(&discs, index);
+                let replan_due = !plan.others.is_empty()
                     && self.world.field.replan_hz > 0.0
                     && self.time + 1e-9 >= run.replans as f64 / self.world.field.replan_hz;
                 if replan_due {
                     run.replans += 1;
                 }
-                match &mut run.field {
-                    GuidanceField::Harmonic(field) if sensed_now || replan_due => {
-                        match HarmonicField::solve_among(
-                            &self.world,
-                            &run.agent,
-                            x.into(),
-                            &run.offsets,
-                            &others,
-                            Some(field),
-                        ) {
-                            Ok(solved) => {
-                                *field = solved;
-                                run.rebuild_failed = false;
-                                if sensed_now {
-                                    *sensed = Some(boundary(field));
-                                }
-                            }
-                            Err(e) => {
-                                if !run.rebuild_failed {
-                                    notes.push(format!(
-                                        "the sensed walls and the other agents give no usable field ({e}); keeping the last one"
-                                    ));
-                                }
-                                run.rebuild_failed = true;
+                plan.resolve = matches!(run.field, GuidanceField::Harmonic(_))
+                    && (plan.sensed_now || replan_due);
+            }
+            plans.push(plan);
+        }
+        // The due harmonic fields, solved in parallel: each solve depends only on its own
+        // agent's plan and last field, so the results do not depend on the order.
+        let world = &self.world;
+        let solved: Vec<Option<Result<HarmonicField, FieldError>>> = self
+            .agents
+            .par_iter()
+            .zip(&plans)
+            .map(|(run, plan)| match &run.field {
+                GuidanceField::Harmonic(field) if plan.resolve => Some(HarmonicField::solve_among(
+                    world,
+                    &run.agent,
+                    plan.x.into(),
+                    &run.offsets,
+                    &plan.others,
+                    Some(field),
+                )),
+                _ => None,
+            })
+            .collect();
+        // Then, in agent order again: the new fields, the control forces.
+        for ((((run, events), notes), sensed), (plan, solved)) in self
+            .agents
+            .iter_mut()
+            .zip(&mut events)
+            .zip(&mut notes)
+            .zip(&mut sensed)
+            .zip(plans.into_iter().zip(solved))
+        {
+            let body = &mut self.physics.bodies[run.body];
+            let (x, v) = (plan.x, plan.v);
+            let mut control = None;
+            if !run.frozen {
+                match (&mut run.field, solved) {
+                    (GuidanceField::Harmonic(field), Some(result)) => match result {
+                        Ok(new) => {
+                            *field = new;
+                            run.rebuild_failed = false;
+                            if plan.sensed_now {
+                                *sensed = Some(boundary(field));
                             }
                         }
-                    }
-                    GuidanceField::Harmonic(_) => {}
-                    GuidanceField::AttractiveRepulsive(field) => {
-                        if sensed_now {
+                        Err(e) => {
+                            if !run.rebuild_failed {
+                                notes.push(format!(
+                                    "the sensed walls and the other agents give no usable field ({e}); keeping the last one"
+                                ));
+                            }
+                            run.rebuild_failed = true;
+                        }
+                    },
+                    (GuidanceField::AttractiveRepulsive(field), _) => {
+                        if plan.sensed_now {
                             field.sense(&run.offsets);
                         }
-                        field.set_others(others);
+                        field.set_others(plan.others);
                     }
+                    (GuidanceField::Harmonic(_), None) => {}
                 }
                 let input = ControlInput {
                     offset: x - Vector2::from(run.agent.target),
