@@ -903,6 +903,50 @@ mod tests {
         );
     }
 
+    /// CG updates its residual rather than recomputing it, from a search direction rounded to
+    /// f32: the residual recomputed in f64 from the returned field must still be the one
+    /// reported, to far below f32's rounding.
+    #[test]
+    fn the_reported_residual_is_the_true_residual() {
+        let n = 128;
+        let grid = Grid::covering([1.0, 1.0], 1.0 / n as f64);
+        let mut unknown = vec![true; grid.len()];
+        for j in 0..n * 2 / 3 {
+            unknown[grid.index(n / 2, j)] = false;
+        }
+        let target = grid.index(n / 8, n / 8);
+        unknown[target] = false;
+        let mut w = vec![0.0; grid.len()];
+        w[target] = 1.0;
+        let stats = solve(&grid, &unknown, &mut w, 1e-12, 100);
+        assert!(stats.relative_residual <= 1e-12, "{stats:?}");
+        let (mut rr, mut bb) = (0.0, 0.0);
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                let k = grid.index(i, j);
+                if !unknown[k] {
+                    continue;
+                }
+                let (mut b, mut sum) = (0.0, 0.0);
+                for (a, c) in grid.neighbours(i, j) {
+                    let m = grid.index(a, c);
+                    sum += w[m];
+                    if !unknown[m] {
+                        b += w[m];
+                    }
+                }
+                rr += (sum - 4.0 * w[k]).powi(2);
+                bb += b * b;
+            }
+        }
+        let truth = (rr / bb).sqrt();
+        assert!(
+            (truth - stats.relative_residual).abs() <= 1e-3 * stats.relative_residual,
+            "true {truth:e}, reported {:e}",
+            stats.relative_residual
+        );
+    }
+
     #[test]
     fn a_warm_start_from_the_solution_needs_no_iteration() {
         let grid = Grid::covering([1.0, 1.0], 0.05);
