@@ -24,7 +24,10 @@
 //! residual restriction (or its prolongation and smoothing passes) run as one wavefront over the
 //! rows, so a level is read from memory once per half-cycle rather than once per pass; every
 //! row loop is straight-line code that the compiler vectorizes, built for AVX2 when the
-//! processor has it (`wide`); and each CG iteration makes two passes over its vectors besides
+//! processor has it (`wide`), and goes over only the row's span of active cells (a nested
+//! solve's bounding box can be half empty); a cycle starts from zero without clearing its
+//! vectors (its first pass reads nothing of them), and it sums `z · r` in its last pass, while
+//! each row is still in cache; and each CG iteration makes two passes over its vectors besides
 //! the cycle (`Krylov`): one makes the new search direction and its curvature `p · A p`, the
 //! other updates the solution and the residual. The search direction is kept in f32, scaled
 //! like the cycle's output it is made from, and `A p` is recomputed from it rather than stored:
