@@ -885,6 +885,27 @@ mod tests {
     use super::*;
     use crate::field::laplace::{reachable_from, solve_sor};
 
+    /// Solves the field of `target` on the free cells reachable from it with multigrid and with
+    /// the SOR reference, both to 1e-13, and checks they agree to 1e-9.
+    fn agrees_with_the_reference(grid: &Grid, blocked: &[bool], target: (usize, usize)) -> Stats {
+        let reachable = reachable_from(grid, blocked, target);
+        let reference = solve_sor(grid, &reachable, target, 1e-13, 1_000_000).unwrap();
+
+        let mut unknown = reachable.clone();
+        unknown[grid.index(target.0, target.1)] = false;
+        let mut w = vec![0.0; grid.len()];
+        w[grid.index(target.0, target.1)] = 1.0;
+        let stats = solve(grid, &unknown, &mut w, 1e-13, 200);
+        assert!(stats.relative_residual <= 1e-13, "{stats:?}");
+        let worst = w
+            .iter()
+            .zip(&reference.w)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "largest difference {worst:e}");
+        stats
+    }
+
     /// A room with a divider and a pocket: multigrid agrees with the SOR reference.
     #[test]
     fn multigrid_matches_the_reference_solver() {
@@ -897,22 +918,8 @@ mod tests {
             blocked[grid.index(i, 12)] = true;
         }
         let target = (50, 8);
-        let reachable = reachable_from(&grid, &blocked, target);
-        let reference = solve_sor(&grid, &reachable, target, 1e-13, 1_000_000).unwrap();
-
-        let mut unknown = reachable.clone();
-        unknown[grid.index(target.0, target.1)] = false;
-        let mut w = vec![0.0; grid.len()];
-        w[grid.index(target.0, target.1)] = 1.0;
-        let stats = solve(&grid, &unknown, &mut w, 1e-13, 200);
-        assert!(stats.relative_residual <= 1e-13, "{stats:?}");
+        let stats = agrees_with_the_reference(&grid, &blocked, target);
         assert!(stats.iterations <= 15, "{stats:?}");
-        let worst = w
-            .iter()
-            .zip(&reference.w)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-9, "largest difference {worst:e}");
     }
 
     /// A domain that fills little of its grid (a slanted band, so every pair of rows spans
@@ -931,21 +938,22 @@ mod tests {
         }
         let target = (30, 15);
         assert!(!blocked[grid.index(target.0, target.1)]);
-        let reachable = reachable_from(&grid, &blocked, target);
-        let reference = solve_sor(&grid, &reachable, target, 1e-13, 1_000_000).unwrap();
+        agrees_with_the_reference(&grid, &blocked, target);
+    }
 
-        let mut unknown = reachable.clone();
-        unknown[grid.index(target.0, target.1)] = false;
+    /// A unit square at `n²` cells with a divider over two thirds of its height and the target
+    /// (`W = 1`) low on one side of it: the grid, the unknown cells and the starting `W`.
+    fn divided_room(n: usize) -> (Grid, Vec<bool>, Vec<f64>) {
+        let grid = Grid::covering([1.0, 1.0], 1.0 / n as f64);
+        let mut unknown = vec![true; grid.len()];
+        for j in 0..n * 2 / 3 {
+            unknown[grid.index(n / 2, j)] = false;
+        }
+        let target = grid.index(n / 8, n / 8);
+        unknown[target] = false;
         let mut w = vec![0.0; grid.len()];
-        w[grid.index(target.0, target.1)] = 1.0;
-        let stats = solve(&grid, &unknown, &mut w, 1e-13, 200);
-        assert!(stats.relative_residual <= 1e-13, "{stats:?}");
-        let worst = w
-            .iter()
-            .zip(&reference.w)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-9, "largest difference {worst:e}");
+        w[target] = 1.0;
+        (grid, unknown, w)
     }
 
     /// The W-cycle's point: the iteration count does not grow with the grid. A room with a
@@ -955,15 +963,7 @@ mod tests {
         let counts: Vec<usize> = [64, 128, 256]
             .iter()
             .map(|&n| {
-                let grid = Grid::covering([1.0, 1.0], 1.0 / n as f64);
-                let mut unknown = vec![true; grid.len()];
-                for j in 0..n * 2 / 3 {
-                    unknown[grid.index(n / 2, j)] = false;
-                }
-                let target = grid.index(n / 8, n / 8);
-                unknown[target] = false;
-                let mut w = vec![0.0; grid.len()];
-                w[target] = 1.0;
+                let (grid, unknown, mut w) = divided_room(n);
                 let stats = solve(&grid, &unknown, &mut w, 1e-10, 100);
                 assert!(stats.relative_residual <= 1e-10, "{stats:?}");
                 stats.iterations
@@ -981,15 +981,7 @@ mod tests {
     #[test]
     fn the_reported_residual_is_the_true_residual() {
         let n = 128;
-        let grid = Grid::covering([1.0, 1.0], 1.0 / n as f64);
-        let mut unknown = vec![true; grid.len()];
-        for j in 0..n * 2 / 3 {
-            unknown[grid.index(n / 2, j)] = false;
-        }
-        let target = grid.index(n / 8, n / 8);
-        unknown[target] = false;
-        let mut w = vec![0.0; grid.len()];
-        w[target] = 1.0;
+        let (grid, unknown, mut w) = divided_room(n);
         let stats = solve(&grid, &unknown, &mut w, 1e-12, 100);
         assert!(stats.relative_residual <= 1e-12, "{stats:?}");
         let (mut rr, mut bb) = (0.0, 0.0);
