@@ -68,15 +68,16 @@ pub struct AgentRun {
 
 /// One agent's part of a step, read before any field is re-solved.
 struct Plan {
-    /// Position and velocity at the start of the step.
+    /// Position at the start of the step.
     x: Vector2<f64>,
+    /// Velocity at the start of the step.
     v: Vector2<f64>,
     /// Whether its sensor took a reading this step.
     sensed_now: bool,
     /// The other agents' discs.
     others: Vec<Disc>,
-    /// Whether its harmonic field is re-solved this step.
-    resolve: bool,
+    /// Whether its field is rebuilt this step (a harmonic one is re-solved, in parallel).
+    rebuild: bool,
 }
 
 /// What happened to one agent in the last step, for recording.
@@ -244,7 +245,7 @@ impl Simulation {
                 v,
                 sensed_now: false,
                 others: Vec::new(),
-                resolve: false,
+                rebuild: false,
             };
             if !run.frozen {
                 plan.sensed_now = match &mut run.sensor {
@@ -261,8 +262,7 @@ impl Simulation {
                 if replan_due {
                     run.replans += 1;
                 }
-                plan.resolve = matches!(run.field, GuidanceField::Harmonic(_))
-                    && (plan.sensed_now || replan_due);
+                plan.rebuild = plan.sensed_now || replan_due;
             }
             plans.push(plan);
         }
@@ -274,7 +274,7 @@ impl Simulation {
             .par_iter()
             .zip(&plans)
             .map(|(run, plan)| match &run.field {
-                GuidanceField::Harmonic(field) if plan.resolve => Some(HarmonicField::solve_among(
+                GuidanceField::Harmonic(field) if plan.rebuild => Some(HarmonicField::solve_among(
                     world,
                     &run.agent,
                     plan.x.into(),
