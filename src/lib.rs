@@ -15,11 +15,15 @@
 //! - [`record`]: the Rerun recording.
 //! - [`run`](mod@run): a whole headless run, as the `nadf run` command does it.
 //! - [`sweep`]: parameter sweeps in parallel, with a CSV and a plot (`nadf sweep`).
+//! - [`cli`]: the `nadf` commands (the binary only parses and dispatches); [`output`]: writing
+//!   files whole or not at all, and checking outputs before a run.
 
+pub mod cli;
 pub mod control;
 pub mod expect;
 pub mod field;
 pub mod metrics;
+pub mod output;
 pub mod record;
 pub mod run;
 pub mod sim;

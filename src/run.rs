@@ -1,15 +1,15 @@
 //! Running a world headlessly: simulate to the world's duration, record, summarize.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use crate::field::FieldError;
-use crate::metrics::Summary;
+use crate::field::{FieldError, FreeSpace};
+use crate::metrics::{self, Summary};
+use crate::output::{self, OutputError};
 use crate::record::{RecordError, Recorder};
 use crate::sim::Simulation;
 use crate::sim::pendulum::PendulumSummary;
@@ -33,23 +33,21 @@ pub struct RunOptions {
 /// Why a run failed.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
-    /// An agent's field could not be built (bad input).
+    /// Some agents' tasks are intractable on their grids: found before anything is solved.
+    #[error("{}", .0.iter().map(ToString::to_string).collect::<Vec<_>>().join("\n"))]
+    Intractable(Vec<FieldError>),
+    /// An agent's field could not be built.
     #[error(transparent)]
     Field(#[from] FieldError),
+    /// An output cannot be written (found before the run, or when writing it).
+    #[error(transparent)]
+    Output(#[from] OutputError),
     /// The recording could not be written.
     #[error(transparent)]
     Record(#[from] RecordError),
     /// Writing to the recording failed mid-run.
     #[error("writing the recording failed: {0}")]
     Stream(#[from] rerun::RecordingStreamError),
-    /// The JSON summary could not be written.
-    #[error("cannot write the summary {path}: {source}")]
-    Json {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
-    },
 }
 
 /// The outcome of a run.
@@ -94,8 +92,28 @@ pub struct FieldStats {
 }
 
 /// Simulates `world` to its duration.
+///
+/// Before anything is solved, it checks that every output can be written and that every
+/// agent's start connects to its target ([`FreeSpace::intractable`]), so a typo or an
+/// impossible task fails at once.
+///
+/// ```
+/// let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/room-two-dividers.toml");
+/// let world = nadf::world::load(&path, &["field.cell=0.1".parse().unwrap()]).unwrap();
+/// let report = nadf::run::run(&world, &nadf::run::RunOptions::default()).unwrap();
+/// let robot = &report.agents[0];
+/// assert!(robot.reached && robot.contacts == 0);
+/// assert!(nadf::expect::failures(&world, &report.agents).is_empty());
+/// ```
 pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
     let started = Instant::now();
+    for path in options.recording.iter().chain(&options.json) {
+        output::check_file(path)?;
+    }
+    let intractable = FreeSpace::intractable(world);
+    if !intractable.is_empty() {
+        return Err(RunError::Intractable(intractable));
+    }
     let mut sim = Simulation::new(world)?;
     let fields = sim
         .agents
@@ -170,26 +188,9 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         interrupted_at,
     };
     if let Some(path) = options.json.as_ref().filter(|_| interrupted_at.is_none()) {
-        write_atomically(path, report.to_json().as_bytes()).map_err(|source| RunError::Json {
-            path: path.clone(),
-            source,
-        })?;
+        output::write_atomically(path, report.to_json().as_bytes())?;
     }
     Ok(report)
-}
-
-/// Writes `bytes` to a temporary file beside `path`, then renames it into place.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut partial = path.as_os_str().to_owned();
-    partial.push(".partial");
-    let partial = PathBuf::from(partial);
-    let result = std::fs::File::create(&partial)
-        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
-        .and_then(|()| std::fs::rename(&partial, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&partial);
-    }
-    result
 }
 
 impl Report {
@@ -213,41 +214,7 @@ impl Report {
                 f.solve_time.as_secs_f64() * 1e3
             );
         }
-        if !self.agents.is_empty() {
-            out += &format!(
-                "{:<12} {:>7} {:>9} {:>9} {:>8} {:>9} {:>9} {:>8} {:>8} {:>9} {:>8}\n",
-                "agent",
-                "reached",
-                "settle_s",
-                "error_m",
-                "contacts",
-                "clear_m",
-                "dev_m",
-                "path_m",
-                "peak_N",
-                "var_N",
-                "vmax"
-            );
-        }
-        for s in &self.agents {
-            let settle = s
-                .settling_time
-                .map_or_else(|| "never".to_string(), |t| format!("{t:.2}"));
-            out += &format!(
-                "{:<12} {:>7} {:>9} {:>9.3} {:>8} {:>9.3} {:>9.3} {:>8.2} {:>8.2} {:>9.2} {:>8.2}\n",
-                s.name,
-                if s.reached { "yes" } else { "no" },
-                settle,
-                s.final_error,
-                s.contacts,
-                s.min_clearance,
-                s.max_deviation,
-                s.path_length,
-                s.peak_force,
-                s.control_variation,
-                s.peak_speed
-            );
-        }
+        out += &metrics::table(&self.agents);
         if !self.pendulums.is_empty() {
             out += &format!(
                 "{:<12} {:>12} {:>9} {:>12} {:>8} {:>7}\n",
@@ -275,22 +242,6 @@ impl Report {
                     u.beta
                 );
             }
-        }
-        for s in self.agents.iter().filter(|s| !s.faults.is_clean()) {
-            let f = &s.faults;
-            out += &format!(
-                "faults of {}: {} steps without guidance, {} rejected forces, {} penetrations, {} steps outside the box{}\n",
-                s.name,
-                f.guidance_lost_steps,
-                f.rejected_forces,
-                f.penetrations,
-                f.left_box_steps,
-                if f.non_finite_state {
-                    ", non-finite state (frozen)"
-                } else {
-                    ""
-                }
-            );
         }
         out
     }

@@ -111,27 +111,23 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(summary["world"], "room-two-dividers");
     let agent = summary["agents"][0].as_object().unwrap();
-    let keys: BTreeSet<&str> = agent.keys().map(String::as_str).collect();
-    let expected: BTreeSet<&str> = [
-        "name",
-        "reached",
-        "settling_time",
-        "final_error",
-        "contacts",
-        "min_clearance",
-        "max_deviation",
-        "path_length",
-        "peak_force",
-        "control_variation",
-        "peak_speed",
-        "final_speed",
-        "distance_covered",
-        "lateral_speed_rms",
-        "lateral_reversals",
-        "faults",
-    ]
-    .into();
+    // The keys are the summary's declared metrics (faults nested under `faults`), and its name.
+    let mut keys = BTreeSet::new();
+    for (key, value) in agent {
+        match value.as_object() {
+            Some(group) => keys.extend(group.keys().map(String::as_str)),
+            None => {
+                keys.insert(key.as_str());
+            }
+        }
+    }
+    let mut expected: BTreeSet<&str> = nadf::metrics::metrics_of::<nadf::metrics::Summary>()
+        .iter()
+        .map(|m| m.key)
+        .collect();
+    expected.insert("name");
     assert_eq!(keys, expected);
+    assert!(agent["faults"].is_object());
     assert_eq!(agent["name"], "robot");
     assert_eq!(agent["contacts"], 0);
 }
@@ -379,4 +375,56 @@ fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
             assert!(!entities.contains(*e), "{world}: unexpected `{e}`");
         }
     }
+}
+
+/// An output that cannot be written is bad input (exit 2), found before anything is solved or
+/// simulated: nothing is printed on standard output and nothing is left behind.
+#[test]
+fn outputs_that_cannot_be_written_are_bad_input_found_before_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let long = ["--set", "duration=100000"];
+    for args in [
+        vec!["-o", "missing/x.rrd"],
+        vec!["--no-record", "--json", "missing/s.json"],
+        vec!["-o", "."],
+    ] {
+        let mut all = args.clone();
+        all.extend_from_slice(&long);
+        let out = run_room(dir.path(), &all);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains("cannot write"), "{args:?}: {stderr}");
+        assert!(out.stdout.is_empty(), "{args:?}: the run started");
+    }
+    let world = world_path("room-two-dividers.toml");
+    let world = world.to_str().unwrap();
+    let out = nadf(dir.path(), &["field", world, "--png", "missing/f.png"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty(), "the field was solved");
+    // A sweep's directory under a file.
+    std::fs::write(dir.path().join("sweep.csv"), "").unwrap();
+    let out = nadf(
+        dir.path(),
+        &[
+            "sweep",
+            world,
+            "--set-range",
+            "agents.0.controller.b=1:2:2",
+            "--out",
+            "sweep.csv/x",
+        ],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.stdout.is_empty());
+    let mut left: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["sweep.csv"]);
 }

@@ -134,3 +134,31 @@ proptest! {
         exercise(&text, &[o]);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    /// Every fixed-length array (positions, sizes, extents, accelerations) rejects any other
+    /// length with an error that names it; none is cut to length or padded.
+    #[test]
+    fn fixed_length_arrays_reject_every_other_length(
+        key in prop::sample::select(vec![
+            "size", "external_acceleration", "walls.0.center", "walls.0.half_extents",
+            "agents.0.start", "agents.0.target",
+        ]),
+        len in prop_oneof![0usize..2, 3usize..6],
+    ) {
+        let text = std::fs::read_to_string(common::world_path("room-two-dividers.toml")).unwrap();
+        let items: Vec<String> = (0..len).map(|i| format!("{}.5", i + 1)).collect();
+        let o: Override = format!("{key}=[{}]", items.join(", ")).parse().unwrap();
+        let errors = load_str(&text, Path::new("fuzz.toml"), &[o]).unwrap_err();
+        let message = errors.to_string();
+        prop_assert!(message.contains(key), "{}", message);
+        prop_assert!(
+            message.contains(&format!("exactly 2 numbers, got {len}"))
+                || (len == 0 && message.contains("got 0")),
+            "{}",
+            message
+        );
+    }
+}

@@ -2,7 +2,7 @@
 
 mod common;
 
-use nadf::field::{HarmonicField, streamline::streamline};
+use nadf::field::HarmonicField;
 
 #[test]
 fn the_maze_is_flat_in_f64_v_yet_every_sampled_streamline_reaches_the_target() {
@@ -26,7 +26,7 @@ fn the_maze_is_flat_in_f64_v_yet_every_sampled_streamline_reaches_the_target() {
                 continue;
             }
             let from = grid.center(i, j);
-            let path = streamline(&field.sampler, from, agent.target, 300.0);
+            let path = field.streamline_within(from, 300.0);
             assert!(
                 path.reached,
                 "the streamline from {from:?} stops at {:?}",

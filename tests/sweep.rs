@@ -18,7 +18,7 @@ fn sweep(kind: &str, range: &str) -> Vec<(f64, nadf::metrics::Summary)> {
     .iter()
     .map(|o| o.parse().unwrap())
     .collect();
-    let cases = cases(&world_path("room-two-dividers.toml"), &ranges, &overrides).unwrap();
+    let (_, cases) = cases(&world_path("room-two-dividers.toml"), &ranges, &overrides).unwrap();
     let keys = vec![ranges[0].path.clone()];
     let done = run_all(&keys, &cases, Some(2), &|| {}, None).unwrap();
     done.runs

@@ -189,3 +189,52 @@ fn non_finite_numbers_are_rejected_wherever_they_appear() {
         assert!(e.contains(&format!("`{key}`")), "{key}: {e}");
     }
 }
+
+/// A fixed-length array with too many or too few numbers is an error at its line and key,
+/// never silently cut to length (`start = [8.5, 1.5, 3.0]` once ran as `[8.5, 1.5]`).
+#[test]
+fn fixed_length_arrays_of_the_wrong_length_are_rejected_at_their_line() {
+    let text = MINIMAL.replace("start = [1.0, 1.0]", "start = [1.0, 1.0, 3.0]");
+    let e = errors(&text, &[]);
+    assert!(e.contains("w.toml:5:"), "{e}");
+    assert!(e.contains("agents.0.start"), "{e}");
+    assert!(e.contains("exactly 2 numbers, got 3"), "{e}");
+
+    let walls = [
+        (
+            "shape = \"box\"\ncenter = [2.0, 2.0, 0.0]\nhalf_extents = [0.1, 0.1]",
+            "center",
+        ),
+        (
+            "shape = \"box\"\ncenter = [2.0, 2.0]\nhalf_extents = [0.1]",
+            "half_extents",
+        ),
+        (
+            "shape = \"segment\"\na = [2.0, 2.0]\nb = [2.5, 2.0, 1.0]\nthickness = 0.1",
+            "b",
+        ),
+        ("shape = \"disc\"\ncenter = [2.0]\nradius = 0.1", "center"),
+        (
+            "shape = \"polygon\"\npoints = [[2.0, 0.5], [2.5, 0.5, 9.0], [2.2, 0.9]]",
+            "points.1",
+        ),
+    ];
+    for (wall, field) in walls {
+        let text = format!("{MINIMAL}\n[[walls]]\n{wall}\n");
+        let e = errors(&text, &[]);
+        assert!(e.contains("exactly 2 numbers"), "{wall}: {e}");
+        // At the field's own line (the wall's table starts on line 12).
+        assert!(e.contains(&format!("`walls.0.{field}`")), "{wall}: {e}");
+        assert!(
+            e.contains("w.toml:14:") || e.contains("w.toml:15:"),
+            "{wall}: {e}"
+        );
+    }
+    let e = errors(MINIMAL, &["size=[4.0, 3.0, 1.0]"]);
+    assert!(
+        e.contains("--set size=[4.0, 3.0, 1.0]") && e.contains("got 3"),
+        "{e}"
+    );
+    let e = errors(MINIMAL, &["external_acceleration=[1.0]"]);
+    assert!(e.contains("got 1"), "{e}");
+}

@@ -1,8 +1,13 @@
 //! Every world shipped in `worlds/` carries the expectations it meets, and `nadf run` checks
-//! them; a missed expectation exits with status 1 and a readable list.
+//! them; a missed expectation exits with status 1 and a readable list. And every world's JSON
+//! summary is byte for byte the one saved in `tests/summaries/`: a change that should not
+//! change behaviour (a restructuring) must leave them all identical. A change that is meant to
+//! change a run re-saves them with `NADF_BLESS=1 cargo test --release --test worlds` and says
+//! why in its commit.
 
 mod common;
 
+use std::path::Path;
 use std::process::Command;
 
 use common::{nadf_bin, world_path};
@@ -39,8 +44,24 @@ fn every_shipped_world_meets_its_expectations() {
             String::from_utf8_lossy(&out.stdout),
             String::from_utf8_lossy(&out.stderr)
         );
-        // And no numerical fault along the way.
         let text = std::fs::read_to_string(&json).unwrap();
+        let stem = path.file_stem().unwrap().to_str().unwrap();
+        let saved = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/summaries")
+            .join(format!("{stem}.json"));
+        if std::env::var_os("NADF_BLESS").is_some() {
+            std::fs::write(&saved, &text).unwrap();
+        } else {
+            let expected = std::fs::read_to_string(&saved)
+                .unwrap_or_else(|e| panic!("{}: {e} (save it with NADF_BLESS=1)", saved.display()));
+            assert!(
+                text == expected,
+                "{}: the summary differs from {}:\n{text}",
+                path.display(),
+                saved.display()
+            );
+        }
+        // And no numerical fault along the way.
         let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
         for (agent, settings) in summary["agents"]
             .as_array()

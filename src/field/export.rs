@@ -6,14 +6,16 @@
 use super::HarmonicField;
 use super::grid::Grid;
 
-/// The cell classes of the mask array.
-pub mod mask {
+/// The class of a cell in the mask array, stored as its `u8` value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum CellClass {
     /// A free cell connected to the target.
-    pub const REACHABLE: u8 = 0;
+    Reachable = 0,
     /// A blocked cell: the agent's centre cannot be there.
-    pub const BLOCKED: u8 = 1;
+    Blocked = 1,
     /// A free cell no path connects to the target.
-    pub const UNREACHABLE: u8 = 2;
+    Unreachable = 2,
 }
 
 /// An `.npy` file (format 1.0) holding a C-ordered `[nx, ny]` array of `descr` elements.
@@ -52,23 +54,19 @@ pub fn one_minus_potential_npy(field: &HarmonicField) -> Vec<u8> {
     npy(field.grid(), "<f8", 8, |k| w[k].to_le_bytes().to_vec())
 }
 
-/// The mask as uint8: [`mask::REACHABLE`], [`mask::BLOCKED`] or [`mask::UNREACHABLE`].
+/// The mask as uint8: one [`CellClass`] per cell.
 pub fn mask_npy(field: &HarmonicField) -> Vec<u8> {
     let reachable = field.sampler.reachable_cells();
     npy(field.grid(), "|u1", 1, |k| {
-        vec![if field.blocked[k] {
-            mask::BLOCKED
+        let class = if field.blocked[k] {
+            CellClass::Blocked
         } else if reachable[k] {
-            mask::REACHABLE
+            CellClass::Reachable
         } else {
-            mask::UNREACHABLE
-        }]
+            CellClass::Unreachable
+        };
+        vec![class as u8]
     })
-}
-
-/// Writes `bytes` to `path` (through a temporary file, so a failure leaves no partial file).
-pub fn write(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
-    crate::run::write_atomically(path, bytes)
 }
 
 /// The paths of the three arrays `--npy FILE` writes: `FILE` (V), `FILE.w.npy` and

@@ -13,8 +13,8 @@
 //! instance), and its gradient is computed in closed form at the body, with no grid.
 
 use nalgebra::Vector2;
-use parry2d::math::Vector;
 
+use super::mask::Disc;
 use super::streamline::{Streamline, integrate};
 use crate::world::{Attraction, WallShape};
 
@@ -22,28 +22,6 @@ use crate::world::{Attraction, WallShape};
 /// FIRAS term grows without bound at contact, and a finite force (however large) is what a
 /// body pushed into a wall by noise or inertia must get, never an infinity.
 pub const MIN_DISTANCE: f64 = 1e-3;
-
-/// Another agent's disc, seen as an obstacle.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Disc {
-    /// Centre, m.
-    pub center: [f64; 2],
-    /// Radius, m.
-    pub radius: f64,
-}
-
-impl Disc {
-    /// The disc as a wall shape, for rasterizing.
-    pub fn shape(&self) -> WallShape {
-        WallShape {
-            pose: parry2d::math::Pose::from_translation(Vector::new(
-                self.center[0] as f32,
-                self.center[1] as f32,
-            )),
-            shape: parry2d::shape::SharedShape::ball(self.radius as f32),
-        }
-    }
-}
 
 /// One agent's attractive-repulsive potential.
 #[derive(Clone)]

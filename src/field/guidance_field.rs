@@ -4,7 +4,8 @@
 
 use nalgebra::Vector2;
 
-use super::firas::{AttractiveRepulsive, Disc};
+use super::firas::AttractiveRepulsive;
+use super::mask::Disc;
 use super::{FieldError, HarmonicField, Streamline};
 use crate::world::{Agent, FieldKind, World, all_wall_shapes};
 

@@ -1,5 +1,6 @@
-//! The production solve of `W = 1 − V`: multigrid-preconditioned CG ([`multigrid`]), then
-//! nested, rescaled re-solves of the regions where `W` is tiny.
+//! An agent's harmonic field ([`HarmonicField`]) and its production solve of `W = 1 − V`:
+//! multigrid-preconditioned CG (`multigrid/`), then nested, rescaled re-solves of the regions
+//! where `W` is tiny.
 //!
 //! A solve to a relative residual of 1e-10 gives `W` to about 1e-12 absolute. Behind a few
 //! turns `W` is far smaller than that (1e-13 in the 10 m room at 1 cm cells, 1e-17 in a
@@ -13,8 +14,130 @@
 //! precision and reaches six orders of magnitude deeper. This repeats until no cell is below the
 //! current depth: the field never goes flat where a path exists.
 
+use std::time::{Duration, Instant};
+
+use nalgebra::Vector2;
+
 use super::grid::Grid;
+use super::mask::CellCounts;
 use super::multigrid;
+use super::{Disc, FieldError, FreeSpace, Sampler, Streamline};
+use crate::world::{Agent, World};
+
+/// The solved field of one agent, with the statistics of the solve.
+#[derive(Debug, Clone)]
+pub struct HarmonicField {
+    /// The field, ready to sample.
+    pub sampler: Sampler,
+    /// The configuration-space mask: `true` where the agent's centre cannot be.
+    pub blocked: Vec<bool>,
+    /// The target, m.
+    pub target: [f64; 2],
+    /// Conjugate gradient iterations over all solves.
+    pub iterations: usize,
+    /// Solves: the first plus the nested ones for the deep regions (see [`solve_w`]).
+    pub solves: usize,
+    /// The worst final relative residual of the solves.
+    pub relative_residual: f64,
+    /// Wall-clock time of the solve.
+    pub solve_time: Duration,
+}
+
+impl HarmonicField {
+    /// Rasterizes the world for `agent` and solves its field.
+    pub fn solve(world: &World, agent: &Agent) -> Result<Self, FieldError> {
+        let started = Instant::now();
+        let space = FreeSpace::of(world, agent)?;
+        Self::solve_space(world, agent, space, None, started)
+    }
+
+    /// Solves the field with the agent at `position`, the walls sensed with `offsets` and the
+    /// discs `others` (the other agents) as obstacles too (see [`FreeSpace::among`]),
+    /// warm-started from `previous` (the last field, on the same grid).
+    pub fn solve_among(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        offsets: &[f64],
+        others: &[Disc],
+        previous: Option<&HarmonicField>,
+    ) -> Result<Self, FieldError> {
+        let started = Instant::now();
+        let space = FreeSpace::among(world, agent, position, offsets, others)?;
+        let warm = previous.map(|f| f.sampler.w_cells());
+        Self::solve_space(world, agent, space, warm, started)
+    }
+
+    fn solve_space(
+        world: &World,
+        agent: &Agent,
+        space: FreeSpace,
+        warm: Option<&[f64]>,
+        started: Instant,
+    ) -> Result<Self, FieldError> {
+        let solution = solve_w(
+            &space.grid,
+            &space.reachable,
+            space.target_cell,
+            world.field.tolerance,
+            warm,
+        );
+        if solution.relative_residual.is_nan() || solution.relative_residual > world.field.tolerance
+        {
+            return Err(FieldError::Solver {
+                agent: agent.name.clone(),
+                iterations: solution.iterations,
+                relative_residual: solution.relative_residual,
+            });
+        }
+        Ok(Self {
+            sampler: Sampler::new(space.grid, solution.w, space.reachable),
+            blocked: space.blocked,
+            target: agent.target,
+            iterations: solution.iterations,
+            solves: solution.solves,
+            relative_residual: solution.relative_residual,
+            solve_time: started.elapsed(),
+        })
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        self.sampler.grid()
+    }
+
+    /// How many cells are reachable, blocked and unreachable.
+    pub fn counts(&self) -> CellCounts {
+        CellCounts::of(&self.blocked, self.sampler.reachable_cells())
+    }
+
+    /// The potential `V` at `p` (1 where nothing reachable is near).
+    pub fn potential(&self, p: [f64; 2]) -> f64 {
+        1.0 - self.sampler.w(p).unwrap_or(0.0)
+    }
+
+    /// `1 - V` at `p`, with full relative precision where `V` is close to 1.
+    pub fn one_minus_potential(&self, p: [f64; 2]) -> f64 {
+        self.sampler.w(p).unwrap_or(0.0)
+    }
+
+    /// The gradient `g = ∇V` at `p`; `None` where the field is undefined (far from any
+    /// reachable cell). Callers treat `None` like a vanishing gradient.
+    pub fn gradient(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
+        self.sampler.grad_w(p).map(|g| -g)
+    }
+
+    /// The kinematic path from `start` (eq. 4, normalized).
+    pub fn streamline(&self, start: [f64; 2]) -> Streamline {
+        let g = self.grid();
+        self.streamline_within(start, 4.0 * (g.nx * g.ny) as f64 * g.cell)
+    }
+
+    /// The streamline from `start`, at most `max_length` long, m.
+    pub fn streamline_within(&self, start: [f64; 2], max_length: f64) -> Streamline {
+        super::streamline::streamline(&self.sampler, start, self.target, max_length)
+    }
+}
 
 /// The depth gained by each nested solve.
 pub const DEPTH_STEP: f64 = 1e-6;

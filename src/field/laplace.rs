@@ -76,7 +76,7 @@ pub fn reachable_from(grid: &Grid, blocked: &[bool], start: (usize, usize)) -> V
     seen
 }
 
-/// Solves `∇²W = 0` on the `reachable` cells (those [`reachable_from`] the free `target` cell)
+/// Solves `∇²W = 0` on the `reachable` cells (those `reachable_from` the free `target` cell)
 /// with `W = 1` at `target` and `W = 0` everywhere else, until no cell changes by more than
 /// `tolerance` relative to its value in one sweep.
 pub fn solve_sor(

@@ -1,19 +1,158 @@
-//! Rasterizing the walls into a configuration-space mask: a cell is blocked when its centre is
-//! closer than the agent's radius to a wall (or to the edge of the box), i.e. when a disc of
-//! that radius centred there would overlap something.
+//! One agent's configuration space on its grid ([`FreeSpace`]): the walls and the other agents
+//! ([`Disc`]) rasterized into a mask — a cell is blocked when its centre is closer than the
+//! agent's radius to a wall (or to the edge of the box), i.e. when a disc of that radius centred
+//! there would overlap something — and the free cells connected to the target.
 
+use super::FieldError;
 use super::grid::Grid;
-use crate::world::WallShape;
+use super::laplace;
+use crate::world::{Agent, FieldKind, WallShape, World, all_wall_shapes};
 
-/// `blocked[grid.index(i, j)]` for every cell, for a disc of `radius` metres in a box of `size`.
-pub fn rasterize(grid: &Grid, size: [f64; 2], walls: &[WallShape], radius: f64) -> Vec<bool> {
-    rasterize_sensed(grid, size, walls, radius, &[])
+/// Another agent's disc, seen as an obstacle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Disc {
+    /// Centre, m.
+    pub center: [f64; 2],
+    /// Radius, m.
+    pub radius: f64,
 }
 
-/// Like [`rasterize`], with wall `k`'s boundary moved out by `offsets[k]` metres (in where
-/// negative; missing offsets are zero): the mask of walls sensed with errors. A cell is blocked
-/// when its signed distance to a wall is below `radius + offset`.
-pub fn rasterize_sensed(
+impl Disc {
+    /// The disc as a wall shape, for rasterizing.
+    pub fn shape(&self) -> WallShape {
+        WallShape {
+            pose: parry2d::math::Pose::from_translation(parry2d::math::Vector::new(
+                self.center[0] as f32,
+                self.center[1] as f32,
+            )),
+            shape: parry2d::shape::SharedShape::ball(self.radius as f32),
+        }
+    }
+}
+
+/// One agent's configuration space on its grid: where its centre may be, and which of those
+/// cells connect to the target. Cheap (no solve), so `nadf check` builds it too.
+#[derive(Debug, Clone)]
+pub struct FreeSpace {
+    /// The grid, anchored on the target.
+    pub grid: Grid,
+    /// `true` where the agent's centre cannot be.
+    pub blocked: Vec<bool>,
+    /// The target's cell.
+    pub target_cell: (usize, usize),
+    /// `true` for the free cells connected to the target cell.
+    pub reachable: Vec<bool>,
+}
+
+impl FreeSpace {
+    /// Rasterizes the world for `agent` and checks that its start connects to its target.
+    pub fn of(world: &World, agent: &Agent) -> Result<Self, FieldError> {
+        Self::among(world, agent, agent.start, &[], &[])
+    }
+
+    /// Like [`FreeSpace::of`] with the agent at `position` instead of its start, walls sensed
+    /// with errors (wall `k` of [`all_wall_shapes`] moved out by `offsets[k]` m, see
+    /// `rasterize`), and the discs `others` (the other agents) as obstacles too.
+    /// A disc that covers the agent's target or the agent itself is left out: an agent parked
+    /// on another's target must not make that target unreachable for good, and two agents in
+    /// contact must still each have a field (the contact is counted by the simulation).
+    pub fn among(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        offsets: &[f64],
+        others: &[Disc],
+    ) -> Result<Self, FieldError> {
+        let grid = Grid::anchored(world.size, world.field.cell, agent.target);
+        let mut walls = all_wall_shapes(world);
+        let margin = agent.radius + std::f64::consts::SQRT_2 * grid.cell;
+        let covers = |d: &Disc, p: [f64; 2]| {
+            (p[0] - d.center[0]).hypot(p[1] - d.center[1]) < d.radius + margin
+        };
+        walls.extend(
+            others
+                .iter()
+                .filter(|d| !covers(d, agent.target) && !covers(d, position))
+                .map(Disc::shape),
+        );
+        let blocked = rasterize(&grid, world.size, &walls, agent.radius, offsets);
+        let target_cell = grid
+            .cell_of(agent.target)
+            .filter(|&(i, j)| !blocked[grid.index(i, j)])
+            .ok_or_else(|| FieldError::TargetBlocked {
+                agent: agent.name.clone(),
+                cell: grid.cell,
+            })?;
+        let reachable = laplace::reachable_from(&grid, &blocked, target_cell);
+        // The start is connected when a cell around it is: the cells the sampler interpolates.
+        let near = |c: usize, n: usize| c.saturating_sub(1)..=(c + 1).min(n - 1);
+        let start_connected = grid.cell_of(position).is_some_and(|(i, j)| {
+            near(i, grid.nx).any(|a| near(j, grid.ny).any(|b| reachable[grid.index(a, b)]))
+        });
+        if !start_connected {
+            return Err(FieldError::Unreachable {
+                agent: agent.name.clone(),
+                radius: agent.radius,
+            });
+        }
+        Ok(Self {
+            grid,
+            blocked,
+            target_cell,
+            reachable,
+        })
+    }
+
+    /// How many cells are reachable, blocked and unreachable.
+    pub fn counts(&self) -> CellCounts {
+        CellCounts::of(&self.blocked, &self.reachable)
+    }
+
+    /// Every agent of `world` whose task is intractable on its grid (the target blocked or
+    /// unreachable from the start), checked without solving anything: what `nadf check`
+    /// reports and what `nadf run` refuses before its first solve. An attractive-repulsive
+    /// field has no grid and no such guarantee (it is the baseline), so nothing is checked.
+    pub fn intractable(world: &World) -> Vec<FieldError> {
+        if world.field.kind != FieldKind::Harmonic {
+            return Vec::new();
+        }
+        world
+            .agents
+            .iter()
+            .filter_map(|agent| Self::of(world, agent).err())
+            .collect()
+    }
+}
+
+/// How many cells of a free space are reachable, blocked, and free but unreachable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CellCounts {
+    /// Free cells connected to the target.
+    pub reachable: usize,
+    /// Cells the agent's centre cannot be in.
+    pub blocked: usize,
+    /// Free cells no path connects to the target.
+    pub unreachable: usize,
+}
+
+impl CellCounts {
+    /// Counts the cells of a mask and its reachable set.
+    pub fn of(blocked: &[bool], reachable: &[bool]) -> Self {
+        let reachable = reachable.iter().filter(|r| **r).count();
+        let blocked_count = blocked.iter().filter(|b| **b).count();
+        Self {
+            reachable,
+            blocked: blocked_count,
+            unreachable: blocked.len() - reachable - blocked_count,
+        }
+    }
+}
+
+/// `blocked[grid.index(i, j)]` for every cell, for a disc of `radius` metres in a box of
+/// `size`, with wall `k`'s boundary moved out by `offsets[k]` metres (in where negative;
+/// missing offsets are zero: the exact walls): the mask of walls sensed with errors. A cell is
+/// blocked when its signed distance to a wall is below `radius + offset`.
+pub fn rasterize(
     grid: &Grid,
     size: [f64; 2],
     walls: &[WallShape],
@@ -80,8 +219,7 @@ mod tests {
         })
         .unwrap();
         let count = |offset: f64| {
-            let blocked =
-                rasterize_sensed(&grid, size, std::slice::from_ref(&wall), 0.2, &[offset]);
+            let blocked = rasterize(&grid, size, std::slice::from_ref(&wall), 0.2, &[offset]);
             // Only the cells around the wall, not the box edges.
             (0..grid.len())
                 .filter(|&k| {
@@ -108,7 +246,7 @@ mod tests {
             radius: 0.3,
         })
         .unwrap();
-        let blocked = rasterize(&grid, size, &[wall], 0.2);
+        let blocked = rasterize(&grid, size, &[wall], 0.2, &[]);
         for j in 0..grid.ny {
             for i in 0..grid.nx {
                 let [x, y] = grid.center(i, j);

@@ -4,46 +4,25 @@
 //! view per plot and a view rooted at the field image.
 
 use rerun::blueprint::components::PlayState;
-use rerun::blueprint::{Blueprint, Horizontal, Spatial2DView, TimePanel, TimeSeriesView, Vertical};
+use rerun::blueprint::{
+    Blueprint, ContainerLike, Horizontal, Spatial2DView, TimePanel, TimeSeriesView, Vertical,
+};
 
+use super::names::{AGENT_SERIES, AGENTS, AgentPaths, PENDULUM_SERIES, Series, WORLD, plot};
 use crate::world::World;
 
 /// The layout for `world`. Every agent's field image is logged, but only the first agent's is
-/// shown (they overlap); the others can be switched on in the viewer.
+/// shown (they overlap); the others can be switched on in the viewer. The time-series views
+/// are those of the series table (`names.rs`) that some body has, in its order.
 pub fn layout(world: &World) -> Blueprint {
-    let mut spatial = vec!["+ /world/**".to_string(), "+ /agents/**".to_string()];
+    let mut spatial = vec![format!("+ /{WORLD}/**"), format!("+ /{AGENTS}/**")];
     for agent in world.agents.iter().skip(1) {
-        spatial.push(format!("- /agents/{}/field/**", agent.name));
+        spatial.push(format!("- {}", AgentPaths::field_of(&agent.name)));
     }
-    let agents: Vec<&str> = world.agents.iter().map(|a| a.name.as_str()).collect();
-    let series = |title: &str, names: &[&str]| series_view(title, &agents, names);
-    let mut views = vec![
-        series("distance to target (m)", &["distance"]).into(),
-        series("speed (m/s)", &["speed", "radial_speed"]).into(),
-        series("control force (N)", &["force", "force_x", "force_y"]).into(),
-        series("potential V", &["potential"]).into(),
-    ];
-    // The clamping, speed-limit and bias signals, when some agent has them.
-    if world
-        .agents
-        .iter()
-        .any(|a| a.controller.clamp.is_some() || a.controller.speed_limit.is_some())
-    {
-        views.push(series("limits active (0/1)", &["clamping", "speed_limited"]).into());
-    }
-    if world.agents.iter().any(|a| a.controller.bias.is_some()) {
-        views.push(series("bias β (N)", &["beta_x", "beta_y"]).into());
-    }
-    if !world.pendulums.is_empty() {
-        let pendulums: Vec<&str> = world.pendulums.iter().map(|p| p.name.as_str()).collect();
-        let pendulum_series = |title: &str, names: &[&str]| series_view(title, &pendulums, names);
-        if world.agents.is_empty() {
-            views.clear();
-        }
-        views.push(pendulum_series("pendulum angle θ (rad)", &["theta", "target"]).into());
-        views.push(pendulum_series("torque u (N·m)", &["torque"]).into());
-        views.push(pendulum_series("bias β (N·m)", &["beta"]).into());
-    }
+    let mut views = series_views(AGENT_SERIES, &world.agents, |a| a.name.as_str());
+    views.extend(series_views(PENDULUM_SERIES, &world.pendulums, |p| {
+        p.name.as_str()
+    }));
     Blueprint::new(
         Horizontal::new([
             Spatial2DView::new(world.name())
@@ -62,11 +41,29 @@ pub fn layout(world: &World) -> Blueprint {
     )
 }
 
-/// A time-series view of the series `names` of every body in `owners` (`/plots/OWNER/NAME`).
-fn series_view(title: &str, owners: &[&str], names: &[&str]) -> TimeSeriesView {
-    let contents: Vec<String> = owners
-        .iter()
-        .flat_map(|o| names.iter().map(move |n| format!("+ /plots/{o}/{n}")))
-        .collect();
-    TimeSeriesView::new(title).with_contents(contents)
+/// One time-series view per view title of `table`, in order, with the series of every owner
+/// that has them (`/plots/OWNER/KEY`); none for a title no owner has a series of.
+fn series_views<Owner, State>(
+    table: &[Series<Owner, State>],
+    owners: &[Owner],
+    name: impl Fn(&Owner) -> &str,
+) -> Vec<ContainerLike> {
+    let mut titles: Vec<&str> = table.iter().map(|s| s.view).collect();
+    titles.dedup();
+    titles
+        .into_iter()
+        .filter_map(|title| {
+            let contents: Vec<String> = owners
+                .iter()
+                .flat_map(|o| {
+                    table
+                        .iter()
+                        .filter(move |s| s.view == title && (s.shown)(o))
+                        .map(|s| format!("+ /{}", plot(name(o), s.key)))
+                })
+                .collect();
+            (!contents.is_empty())
+                .then(|| TimeSeriesView::new(title).with_contents(contents).into())
+        })
+        .collect()
 }

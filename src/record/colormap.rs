@@ -1,11 +1,7 @@
 //! The potential as a picture: `log10(1 - V)` through a perceptual colour map.
 
+use super::palette::{BLOCKED, UNREACHABLE};
 use crate::field::HarmonicField;
-
-/// Colour of blocked cells.
-const BLOCKED: [u8; 3] = [70, 70, 70];
-/// Colour of free cells that cannot reach the target.
-const UNREACHABLE: [u8; 3] = [0, 0, 0];
 
 /// The agent's field as RGB bytes, row `j` of the image being grid row `j` (y up in the world;
 /// the recording's transforms put it the right way up), and the image's `[width, height]`.

@@ -3,6 +3,7 @@
 //! start, and the start and target. No fonts needed.
 
 use super::colormap::potential_image;
+use super::palette;
 use crate::field::HarmonicField;
 use crate::world::Agent;
 
@@ -52,22 +53,17 @@ pub fn field_picture(field: &HarmonicField, agent: &Agent) -> (Vec<u8>, u32, u32
     for j in (stride / 2..grid.ny).step_by(stride) {
         for i in (stride / 2..grid.nx).step_by(stride) {
             if reachable[grid.index(i, j)] {
-                let line = crate::field::streamline::streamline(
-                    &field.sampler,
-                    grid.center(i, j),
-                    agent.target,
-                    max_length,
-                );
+                let line = field.streamline_within(grid.center(i, j), max_length);
                 for p in &line.points {
-                    dot(*p, 0, [225, 225, 225]);
+                    dot(*p, 0, palette::STREAMLINE);
                 }
             }
         }
     }
     for p in &field.streamline(agent.start).points {
-        dot(*p, 1, [80, 200, 255]);
+        dot(*p, 1, palette::KINEMATIC);
     }
-    dot(agent.start, 5, [255, 255, 255]);
-    dot(agent.target, 5, [80, 255, 120]);
+    dot(agent.start, 5, palette::START);
+    dot(agent.target, 5, palette::TARGET);
     (rgb, width as u32, height as u32)
 }

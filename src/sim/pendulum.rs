@@ -170,7 +170,7 @@ pub fn insert(physics: &mut PhysicsWorld, pendulum: &Pendulum) -> PendulumRun {
 
 impl PendulumRun {
     /// Computes the torque for the step that starts at `time` (s) and applies it to the bob.
-    pub fn control(&mut self, physics: &mut PhysicsWorld, time: f64, dt: f64) {
+    pub fn apply(&mut self, physics: &mut PhysicsWorld, time: f64, dt: f64) {
         let input = ControlInput {
             offset: Vector1::new(self.state.theta - self.pendulum.target),
             velocity: Vector1::new(self.state.omega),

@@ -19,9 +19,9 @@ use rayon::prelude::*;
 
 pub use plot::plot;
 
-use crate::metrics::Summary;
+use crate::metrics::{self, Summary, csv_field};
 use crate::run::{RunError, RunOptions, run};
-use crate::world::{Override, World, WorldErrors, load};
+use crate::world::{Override, World, WorldErrors, WorldFile};
 
 /// The most runs one sweep may have.
 pub const MAX_RUNS: usize = 100_000;
@@ -173,16 +173,20 @@ fn describe(keys: &[String], values: &[f64]) -> String {
         .join(", ")
 }
 
-/// Every combination of the ranges' values as a valid world, loaded from `path` with the fixed
-/// `overrides` and the swept values.
+/// Every combination of the ranges' values as a valid world, loaded from `path` (read once)
+/// with the fixed `overrides` and the swept values; and the file, for its warnings.
 pub fn cases(
     path: &Path,
     ranges: &[Range],
     overrides: &[Override],
-) -> Result<Vec<Case>, SweepError> {
+) -> Result<(WorldFile, Vec<Case>), SweepError> {
     if ranges.is_empty() {
         return Err(SweepError::NoRange);
     }
+    let file = WorldFile::read(path).map_err(|errors| SweepError::World {
+        values: "no swept values".into(),
+        errors,
+    })?;
     let total = ranges
         .iter()
         .try_fold(1usize, |n, r| n.checked_mul(r.count))
@@ -205,7 +209,7 @@ pub fn cases(
             })
             .collect();
     }
-    combos
+    let cases = combos
         .into_iter()
         .map(|values| {
             let mut all = overrides.to_vec();
@@ -214,13 +218,14 @@ pub fn cases(
                 // `{:?}` keeps a decimal point, so TOML reads a float even for whole values.
                 value: format!("{v:?}"),
             }));
-            let world = load(path, &all).map_err(|errors| SweepError::World {
+            let world = file.load(&all).map_err(|errors| SweepError::World {
                 values: describe(&keys, &values),
                 errors,
             })?;
             Ok(Case { values, world })
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    Ok((file, cases))
 }
 
 /// Runs every case on `threads` threads (all cores when `None`), calling `progress` after each
@@ -284,76 +289,20 @@ impl Sweep {
     /// The CSV table: one row per run and agent, the swept values first, then the agent and
     /// every summary metric (an empty cell where a metric has no value: never settled).
     pub fn csv(&self) -> String {
-        let mut out = String::new();
-        let mut header: Vec<String> = self.keys.iter().map(|k| csv_field(k)).collect();
-        header.extend(
-            [
-                "agent",
-                "reached",
-                "settling_time",
-                "final_error",
-                "contacts",
-                "min_clearance",
-                "max_deviation",
-                "path_length",
-                "peak_force",
-                "control_variation",
-                "peak_speed",
-                "final_speed",
-                "distance_covered",
-                "lateral_speed_rms",
-                "lateral_reversals",
-                "guidance_lost_steps",
-                "rejected_forces",
-                "penetrations",
-                "left_box_steps",
-                "non_finite_state",
-            ]
-            .map(String::from),
-        );
-        out.push_str(&header.join(","));
-        out.push('\n');
-        for (values, summaries) in &self.runs {
-            for s in summaries {
-                let mut row: Vec<String> = values.iter().map(|v| format!("{v}")).collect();
-                let f = &s.faults;
-                row.extend([
-                    csv_field(&s.name),
-                    s.reached.to_string(),
-                    s.settling_time.map_or_else(String::new, |t| format!("{t}")),
-                    format!("{}", s.final_error),
-                    s.contacts.to_string(),
-                    format!("{}", s.min_clearance),
-                    format!("{}", s.max_deviation),
-                    format!("{}", s.path_length),
-                    format!("{}", s.peak_force),
-                    format!("{}", s.control_variation),
-                    format!("{}", s.peak_speed),
-                    format!("{}", s.final_speed),
-                    s.distance_covered
-                        .map_or_else(String::new, |d| format!("{d}")),
-                    format!("{}", s.lateral_speed_rms),
-                    s.lateral_reversals.to_string(),
-                    f.guidance_lost_steps.to_string(),
-                    f.rejected_forces.to_string(),
-                    f.penetrations.to_string(),
-                    f.left_box_steps.to_string(),
-                    f.non_finite_state.to_string(),
-                ]);
-                out.push_str(&row.join(","));
-                out.push('\n');
-            }
-        }
-        out
-    }
-}
-
-/// A CSV field, quoted when it needs to be (RFC 4180).
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
+        let mut keys = self.keys.clone();
+        keys.push("agent".into());
+        let rows: Vec<(Vec<String>, &Summary)> = self
+            .runs
+            .iter()
+            .flat_map(|(values, summaries)| {
+                summaries.iter().map(move |s| {
+                    let mut leading: Vec<String> = values.iter().map(|v| format!("{v}")).collect();
+                    leading.push(csv_field(&s.name));
+                    (leading, s)
+                })
+            })
+            .collect();
+        metrics::csv(&keys, &rows)
     }
 }
 
@@ -387,12 +336,5 @@ mod tests {
         ] {
             assert!(bad.parse::<Range>().is_err(), "{bad}");
         }
-    }
-
-    #[test]
-    fn csv_fields_are_quoted_when_needed() {
-        assert_eq!(csv_field("robot"), "robot");
-        assert_eq!(csv_field("a,b"), "\"a,b\"");
-        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
     }
 }

@@ -8,7 +8,7 @@
 //! causes names the `--set` rather than a line of the file.
 
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use toml_edit::{DocumentMut, Item, TableLike, Value};
@@ -54,18 +54,79 @@ impl std::fmt::Display for Override {
     }
 }
 
-/// Reads, overrides, parses and validates a world file. The world's `name` defaults to the
-/// file stem. Every problem found is returned, not only the first.
+/// A world file read into memory once: loaded with any overrides (a sweep loads it many
+/// times), and its warnings located in the same text.
+#[derive(Debug, Clone)]
+pub struct WorldFile {
+    path: PathBuf,
+    text: String,
+}
+
+impl WorldFile {
+    /// Reads the file at `path`.
+    pub fn read(path: &Path) -> Result<Self, WorldErrors> {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            WorldErrors(vec![WorldError {
+                file: path.to_path_buf(),
+                location: None,
+                key: None,
+                message: format!("cannot read the file: {e}"),
+            }])
+        })?;
+        Ok(Self::from_text(text, path))
+    }
+
+    /// A world file whose text is already in memory; `path` is used for messages and the
+    /// default name.
+    pub fn from_text(text: impl Into<String>, path: &Path) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            text: text.into(),
+        }
+    }
+
+    /// The file's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Applies `overrides`, parses and validates. The world's `name` defaults to the file
+    /// stem. Every problem found is returned, not only the first.
+    pub fn load(&self, overrides: &[Override]) -> Result<World, WorldErrors> {
+        load_str(&self.text, &self.path, overrides)
+    }
+
+    /// The warnings about `world`, loaded from this file (see [`super::validate::warnings`]),
+    /// located in the file by key. They never stop a run; `nadf check` and `nadf run` print
+    /// them.
+    pub fn warnings(&self, world: &World) -> Vec<WorldError> {
+        let spans = Spans::of(&self.text);
+        unlocated_warnings(world)
+            .into_iter()
+            .map(|(key, message)| WorldError {
+                file: self.path.clone(),
+                location: spans
+                    .span_of(&key)
+                    .map(|s| line_column(&self.text, s.start)),
+                key: Some(key),
+                message,
+            })
+            .collect()
+    }
+}
+
+/// Reads, overrides, parses and validates a world file: [`WorldFile::read`] then
+/// [`WorldFile::load`].
+///
+/// ```
+/// let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/room-two-dividers.toml");
+/// let set: nadf::world::Override = "agents.0.controller.b=3".parse().unwrap();
+/// let world = nadf::world::load(&path, &[set]).unwrap();
+/// assert_eq!(world.name(), "room-two-dividers");
+/// assert_eq!(world.agents[0].controller.b, Some(3.0));
+/// ```
 pub fn load(path: &Path, overrides: &[Override]) -> Result<World, WorldErrors> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        WorldErrors(vec![WorldError {
-            file: path.to_path_buf(),
-            location: None,
-            key: None,
-            message: format!("cannot read the file: {e}"),
-        }])
-    })?;
-    load_str(&text, path, overrides)
+    WorldFile::read(path)?.load(overrides)
 }
 
 /// Like [`load`], for text already in memory; `file` is used for messages and the default name.
@@ -126,22 +187,6 @@ pub fn load_str(text: &str, file: &Path, overrides: &[Override]) -> Result<World
     })
 }
 
-/// The warnings about a loaded world (see [`super::validate::warnings`]), located in its file
-/// by key. They never stop a run; `nadf check` and `nadf run` print them.
-pub fn warnings(path: &Path, world: &World) -> Vec<WorldError> {
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    let spans = Spans::of(&text);
-    unlocated_warnings(world)
-        .into_iter()
-        .map(|(key, message)| WorldError {
-            file: path.to_path_buf(),
-            location: spans.span_of(&key).map(|s| line_column(&text, s.start)),
-            key: Some(key),
-            message,
-        })
-        .collect()
-}
-
 /// A problem found while parsing or validating, located by span in the text that was parsed.
 struct Problem {
     span: Option<Range<usize>>,
@@ -151,8 +196,8 @@ struct Problem {
 
 /// TOML syntax → serde → default name → validation.
 fn parse(text: &str, file: &Path) -> Result<World, Vec<Problem>> {
-    let spans = match toml_edit::Document::parse(text) {
-        Ok(doc) => Spans::from_doc(&doc),
+    let doc = match toml_edit::Document::parse(text) {
+        Ok(doc) => doc,
         Err(e) => {
             return Err(vec![Problem {
                 span: e.span(),
@@ -161,13 +206,26 @@ fn parse(text: &str, file: &Path) -> Result<World, Vec<Problem>> {
             }]);
         }
     };
+    let spans = Spans::from_doc(&doc);
     let mut world: World = toml::from_str(text).map_err(|e| {
-        let span = e.span();
-        let key = span.as_ref().and_then(|s| spans.key_at(s.start));
+        let mut span = e.span();
+        let mut key = span.as_ref().and_then(|s| spans.key_at(s.start));
+        let mut message = e.message().trim();
+        // A message that names a field (`` `center`: … got 3``) comes from inside an
+        // internally tagged wall, which serde locates at a wall's table (not always the right
+        // one): it points at the first such field of the same list whose array has the length
+        // the message gives.
+        if let (Some(located), Some((field, rest))) = (&key, field_prefix(message))
+            && let Some(len) = rest.rsplit("got ").next().and_then(first_number)
+            && let Some(list) = located.split('.').next()
+            && let Some((k, at)) = spans.array_of_length(&doc, list, field, len)
+        {
+            (key, span, message) = (Some(k), Some(at), rest);
+        }
         vec![Problem {
             span,
             key,
-            message: with_suggestion(e.message().trim()),
+            message: with_suggestion(message),
         }]
     })?;
     if world.name.is_none() {
@@ -214,6 +272,35 @@ impl Spans {
             .map(|(k, _)| k.clone())
     }
 
+    /// The first key under `list` that is an item of `field` (a point of a polygon) or
+    /// `field` itself, in that order of preference, and holds an array of `len` items in `doc`.
+    fn array_of_length(
+        &self,
+        doc: &toml_edit::Document<&str>,
+        list: &str,
+        field: &str,
+        len: usize,
+    ) -> Option<(String, Range<usize>)> {
+        let under = |k: &str| {
+            k.strip_prefix(list)
+                .is_some_and(|rest| rest.starts_with('.'))
+        };
+        let item_of_field = |k: &str| {
+            let mut segments = k.rsplit('.');
+            segments.next().is_some_and(|l| l.parse::<usize>().is_ok())
+                && segments.next() == Some(field)
+        };
+        let is_field = |k: &str| k.rsplit('.').next() == Some(field);
+        [&item_of_field as &dyn Fn(&str) -> bool, &is_field]
+            .into_iter()
+            .find_map(|matches| {
+                self.0
+                    .iter()
+                    .find(|(k, _)| under(k) && matches(k) && array_len(doc, k) == Some(len))
+            })
+            .cloned()
+    }
+
     /// The span of `path`, or of its nearest ancestor in the document.
     fn span_of(&self, path: &str) -> Option<Range<usize>> {
         let mut path = path;
@@ -224,6 +311,47 @@ impl Spans {
             path = &path[..path.rfind('.')?];
         }
     }
+}
+
+/// The whole number at the start of `text`.
+fn first_number(text: &str) -> Option<usize> {
+    let digits: String = text.chars().take_while(char::is_ascii_digit).collect();
+    digits.parse().ok()
+}
+
+/// The number of items of the array at the dotted `path` of `doc`, if there is one.
+fn array_len(doc: &toml_edit::Document<&str>, path: &str) -> Option<usize> {
+    enum Node<'a> {
+        Table(&'a dyn TableLike),
+        Item(&'a Item),
+        Value(&'a Value),
+    }
+    let mut node = Node::Table(doc.as_table());
+    for segment in path.split('.') {
+        let index = || segment.parse::<usize>().ok();
+        node = match node {
+            Node::Table(t) => Node::Item(t.get(segment)?),
+            Node::Item(Item::Table(t)) => Node::Item(t.get(segment)?),
+            Node::Item(Item::ArrayOfTables(a)) => Node::Table(a.get(index()?)?),
+            Node::Item(Item::Value(v)) | Node::Value(v) => match v {
+                Value::Array(a) => Node::Value(a.get(index()?)?),
+                Value::InlineTable(t) => Node::Value(t.get(segment)?),
+                _ => return None,
+            },
+            Node::Item(Item::None) => return None,
+        };
+    }
+    match node {
+        Node::Item(Item::Value(Value::Array(a))) | Node::Value(Value::Array(a)) => Some(a.len()),
+        _ => None,
+    }
+}
+
+/// `` `field`: rest `` → `(field, rest)`.
+fn field_prefix(message: &str) -> Option<(&str, &str)> {
+    let (field, rest) = message.strip_prefix('`')?.split_once("`: ")?;
+    (!field.is_empty() && field.chars().all(|c| c.is_ascii_alphanumeric() || c == '_'))
+        .then_some((field, rest))
 }
 
 fn join(prefix: &str, key: &str) -> String {

@@ -7,20 +7,20 @@ mod error;
 mod load;
 mod schema;
 mod shapes;
-mod suggest;
+pub(crate) mod suggest;
 mod validate;
 
 pub use error::{WorldError, WorldErrors};
-pub use load::{Override, load, load_str, warnings};
+pub use load::{Override, WorldFile, load, load_str};
 pub use schema::{
     Agent, Attraction, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K,
-    Expect, FieldKind, FieldSettings, GuidanceKind, OUTER_WALL_THICKNESS, Pendulum,
-    PendulumController, PendulumExpect, SensorSettings, Wall, World,
+    Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind, MAX_CELLS, OUTER_WALL_THICKNESS,
+    Pendulum, PendulumController, PendulumExpect, SensorSettings, Wall, World,
 };
-pub use shapes::{WallShape, all_wall_shapes, all_walls, outer_walls, wall_shape};
-pub use validate::{MAX_CELLS, validate};
+pub use shapes::{WallShape, all_wall_shapes, all_walls, named_walls, outer_walls, wall_shape};
+pub use validate::validate;
 
-/// The unlocated form of [`warnings`], for a world built in code.
+/// The unlocated form of [`WorldFile::warnings`], for a world built in code.
 pub use validate::warnings as settings_warnings;
 
 impl World {

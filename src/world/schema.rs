@@ -3,7 +3,9 @@
 //! Defaults live here, next to the field they belong to, so that `worlds/README.md` and the
 //! code cannot disagree about them for long: every default is a named function below.
 
-use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Deserializer, Serialize};
 
 /// A whole world: the box, its walls, its agents and how long to simulate them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -13,6 +15,7 @@ pub struct World {
     #[serde(default)]
     pub name: Option<String>,
     /// The box `[0, W] × [0, H]`, in metres.
+    #[serde(deserialize_with = "exactly")]
     pub size: [f64; 2],
     /// Add four walls of [`OUTER_WALL_THICKNESS`] just inside the box.
     #[serde(default = "default_true")]
@@ -29,7 +32,7 @@ pub struct World {
     /// A constant external acceleration on every agent, m/s² (the paper's drift, eq. 71:
     /// `[-4, -4]`; or gravity). Rapier applies it as gravity, `m·a` on each body. The
     /// controllers do not know it.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exactly")]
     pub external_acceleration: [f64; 2],
     /// Time at which each agent's distance from its start is reported as `distance_covered`,
     /// s (the paper's corridor: "25 metres in 10 seconds").
@@ -53,41 +56,69 @@ pub struct World {
     pub expect: Option<Expect>,
 }
 
-/// An `[expect]` table: assertions on a run's summary, for users' own collision tests. Every
-/// key is optional; `nadf run` checks the ones given and exits with status 1, listing what
-/// failed, when any does not hold.
+/// An `[expect]` table: assertions on a run's summary, for users' own collision tests. Each
+/// key names a metric of the summary (`metrics::Summary`) and how it is bounded:
+/// `max_<metric>` (at most), `min_<metric>` (at least), or `<metric>` (exactly, for a yes/no
+/// or whole-number metric), e.g. `reached = true`, `contacts = 0`, `max_settling_time = 6.0`.
+/// `nadf run` checks them and exits with status 1, listing what failed, when any does not hold;
+/// validation rejects a key that names no metric (see `crate::expect`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Expect {
-    /// Whether the agent must end within the settling band (`true`) or outside it (`false`).
-    pub reached: Option<bool>,
-    /// The exact number of contact starts (`contacts = 0`: never touch anything).
-    pub contacts: Option<usize>,
-    /// At least this many contact starts (for worlds that show a crash).
-    pub min_contacts: Option<usize>,
-    /// At most this many contact starts.
-    pub max_contacts: Option<usize>,
-    /// The agent must settle, and no later than this, s.
-    pub max_settling_time: Option<f64>,
-    /// The smallest clearance to the walls must be at least this, m.
-    pub min_clearance: Option<f64>,
-    /// The final distance to the target must be at most this, m.
-    pub max_final_error: Option<f64>,
-    /// `δ_m` must be at most this, m.
-    pub max_deviation: Option<f64>,
-    /// The peak speed must be at most this, m/s.
-    pub max_peak_speed: Option<f64>,
-    /// The peak control force must be at most this, N.
-    pub max_peak_force: Option<f64>,
-    /// The speed at the end must be at most this, m/s (a body that must have stopped).
-    pub max_final_speed: Option<f64>,
-    /// The distance from the start at the world's `distance_at` time must be at least this, m.
-    pub min_distance_covered: Option<f64>,
-    /// The distance from the start at the world's `distance_at` time must be at most this, m.
-    pub max_distance_covered: Option<f64>,
-    /// The sideways reversals (`lateral_reversals`) must be at most this many.
-    pub max_lateral_reversals: Option<usize>,
+#[serde(transparent)]
+pub struct Expect(pub BTreeMap<String, ExpectValue>);
+
+/// The value of an expectation: `true`/`false`, a whole number or a real number.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum ExpectValue {
+    /// `true` or `false`.
+    Flag(bool),
+    /// A whole number.
+    Integer(i64),
+    /// A real number.
+    Real(f64),
 }
+
+impl<'de> Deserialize<'de> for ExpectValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = ExpectValue;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number, or true or false")
+            }
+            fn visit_bool<E>(self, v: bool) -> Result<ExpectValue, E> {
+                Ok(ExpectValue::Flag(v))
+            }
+            fn visit_i64<E>(self, v: i64) -> Result<ExpectValue, E> {
+                Ok(ExpectValue::Integer(v))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<ExpectValue, E> {
+                i64::try_from(v)
+                    .map(ExpectValue::Integer)
+                    .map_err(|_| E::custom(format!("{v} is too large")))
+            }
+            fn visit_f64<E>(self, v: f64) -> Result<ExpectValue, E> {
+                Ok(ExpectValue::Real(v))
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+impl std::fmt::Display for ExpectValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Flag(b) => write!(f, "{b}"),
+            Self::Integer(n) => write!(f, "{n}"),
+            Self::Real(x) => write!(f, "{x}"),
+        }
+    }
+}
+
+/// The default of `field.max_cells`, the largest grid accepted (4096 × 4096 cells, about 640 MB
+/// per agent). A world whose `size` and `field.cell` give more cells is rejected unless it
+/// raises `field.max_cells`.
+pub const MAX_CELLS: u64 = 4096 * 4096;
 
 /// Thickness of the walls that `walls_around = true` adds, m.
 pub const OUTER_WALL_THICKNESS: f64 = 0.1;
@@ -185,8 +216,10 @@ pub enum Wall {
     /// A rectangle, possibly rotated.
     Box {
         /// Centre, m.
+        #[serde(deserialize_with = "wall_center")]
         center: [f64; 2],
         /// Half width and half height, m.
+        #[serde(deserialize_with = "wall_half_extents")]
         half_extents: [f64; 2],
         /// Rotation about the centre, rad (counter-clockwise).
         #[serde(default)]
@@ -195,8 +228,10 @@ pub enum Wall {
     /// A thick segment from `a` to `b`: a capsule of radius `thickness / 2`.
     Segment {
         /// First end point, m.
+        #[serde(deserialize_with = "wall_a")]
         a: [f64; 2],
         /// Second end point, m.
+        #[serde(deserialize_with = "wall_b")]
         b: [f64; 2],
         /// Full thickness, m.
         thickness: f64,
@@ -204,6 +239,7 @@ pub enum Wall {
     /// A solid disc.
     Disc {
         /// Centre, m.
+        #[serde(deserialize_with = "wall_center")]
         center: [f64; 2],
         /// Radius, m.
         radius: f64,
@@ -211,6 +247,7 @@ pub enum Wall {
     /// A convex polygon, vertices counter-clockwise.
     Polygon {
         /// Vertices, m.
+        #[serde(deserialize_with = "wall_points")]
         points: Vec<[f64; 2]>,
     },
 }
@@ -222,8 +259,10 @@ pub struct Agent {
     /// Name, unique in the world; used in entity paths and the summary.
     pub name: String,
     /// Start position, m.
+    #[serde(deserialize_with = "exactly")]
     pub start: [f64; 2],
     /// Target position, m.
+    #[serde(deserialize_with = "exactly")]
     pub target: [f64; 2],
     /// Disc radius, m.
     #[serde(default = "default_radius")]
@@ -251,6 +290,7 @@ pub struct Pendulum {
     /// Name, unique in the world; used in entity paths and the summary.
     pub name: String,
     /// The pivot, m.
+    #[serde(deserialize_with = "exactly")]
     pub pivot: [f64; 2],
     /// Rod length L, m.
     #[serde(default = "default_length")]
@@ -421,7 +461,7 @@ fn default_tolerance() -> f64 {
     1e-12
 }
 fn default_max_cells() -> u64 {
-    super::validate::MAX_CELLS
+    MAX_CELLS
 }
 fn default_radius() -> f64 {
     0.2
@@ -437,4 +477,63 @@ fn default_dwell() -> f64 {
 }
 fn default_capture_radius() -> f64 {
     0.25
+}
+
+/// A fixed-length array of numbers that rejects any other length. (serde's own `[f64; N]` reads
+/// the first N items and silently drops the rest: `start = [8.5, 1.5, 3.0]` would run as
+/// `[8.5, 1.5]`.)
+fn exactly<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<[f64; N], D::Error> {
+    fixed_length(Vec::<f64>::deserialize(d)?, None)
+}
+
+/// [`exactly`] for the field `name` of a wall. A wall is an internally tagged enum, whose
+/// errors serde locates at the wall's table rather than at the field: the message starts with
+/// the field's name (`` `center`: … ``), which the loader uses to point at the field's line.
+fn exactly_named<'de, D: Deserializer<'de>, const N: usize>(
+    d: D,
+    name: &str,
+) -> Result<[f64; N], D::Error> {
+    fixed_length(Vec::<f64>::deserialize(d)?, Some(name))
+}
+
+fn wall_center<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    exactly_named(d, "center")
+}
+
+fn wall_half_extents<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    exactly_named(d, "half_extents")
+}
+
+fn wall_a<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    exactly_named(d, "a")
+}
+
+fn wall_b<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    exactly_named(d, "b")
+}
+
+/// A wall's list of points, each checked like [`exactly`].
+fn wall_points<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    Vec::<Vec<f64>>::deserialize(d)?
+        .into_iter()
+        .map(|p| fixed_length(p, Some("points")))
+        .collect()
+}
+
+fn fixed_length<E: serde::de::Error, const N: usize>(
+    items: Vec<f64>,
+    name: Option<&str>,
+) -> Result<[f64; N], E> {
+    let len = items.len();
+    items.try_into().map_err(|_| {
+        let field = name.map_or_else(String::new, |n| format!("`{n}`: "));
+        let dropped = if len > N {
+            " (extra numbers are not dropped silently)"
+        } else {
+            ""
+        };
+        E::custom(format!(
+            "{field}expected an array of exactly {N} numbers, got {len}{dropped}"
+        ))
+    })
 }

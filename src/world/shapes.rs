@@ -105,11 +105,25 @@ pub fn all_wall_shapes(world: &World) -> Vec<WallShape> {
 
 /// Every wall of the world, the outer ones (if any) first.
 pub fn all_walls(world: &World) -> Vec<Wall> {
-    let mut walls = if world.walls_around {
+    named_walls(world).map(|(_, wall)| wall).collect()
+}
+
+/// Every wall of the world in the order of [`all_walls`], with the name a message gives it:
+/// `the outer wall`, or `walls.N` for the world file's `[[walls]]` entry N.
+pub fn named_walls(world: &World) -> impl Iterator<Item = (String, Wall)> + '_ {
+    let outer = if world.walls_around {
         outer_walls(world.size)
     } else {
         Vec::new()
     };
-    walls.extend(world.walls.iter().cloned());
-    walls
+    outer
+        .into_iter()
+        .map(|w| ("the outer wall".to_string(), w))
+        .chain(
+            world
+                .walls
+                .iter()
+                .enumerate()
+                .map(|(i, w)| (format!("walls.{i}"), w.clone())),
+        )
 }

@@ -13,17 +13,23 @@ pub fn with_suggestion(message: &str) -> String {
     let Some((unknown, expected)) = rest.split_once('`') else {
         return message.to_string();
     };
-    let best = expected
-        .split('`')
-        .skip(1)
-        .step_by(2)
-        .map(|candidate| (edit_distance(unknown, candidate), candidate))
-        .filter(|(d, _)| *d <= 2)
-        .min_by_key(|(d, _)| *d);
-    match best {
-        Some((_, candidate)) => format!("{message}; did you mean `{candidate}`?"),
+    match closest(unknown, expected.split('`').skip(1).step_by(2)) {
+        Some(candidate) => format!("{message}; did you mean `{candidate}`?"),
         None => message.to_string(),
     }
+}
+
+/// The candidate within two edits of `unknown` that is closest to it, if any.
+pub fn closest<'a>(
+    unknown: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
+    candidates
+        .into_iter()
+        .map(|candidate| (edit_distance(unknown, candidate), candidate))
+        .filter(|(d, _)| *d <= 2)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, candidate)| candidate)
 }
 
 /// Levenshtein distance, in characters.

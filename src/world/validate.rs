@@ -4,14 +4,9 @@
 
 use super::schema::{
     Agent, Attraction, ControllerKind, ControllerSettings, Expect, FieldKind, FieldSettings,
-    GuidanceKind, Wall, World,
+    GuidanceKind, MAX_CELLS, Wall, World,
 };
-use super::shapes::{outer_walls, wall_shape};
-
-/// The default of `field.max_cells`, the largest grid accepted (4096 × 4096 cells, about 640 MB
-/// per agent). A world whose `size` and `field.cell` give more cells is rejected unless it
-/// raises `field.max_cells`.
-pub const MAX_CELLS: u64 = 4096 * 4096;
+use super::shapes::{named_walls, wall_shape};
 
 /// Every problem in a parsed world, as `(key path, message)`; empty when the world is valid.
 pub fn validate(world: &World) -> Vec<(String, String)> {
@@ -281,33 +276,10 @@ fn check_field_kind(bad: &mut impl FnMut(String, String), field: &FieldSettings)
 }
 
 fn check_expect(bad: &mut impl FnMut(String, String), key: &str, e: &Expect) {
-    for (name, value) in [
-        ("max_settling_time", e.max_settling_time),
-        ("min_clearance", e.min_clearance),
-        ("max_final_error", e.max_final_error),
-        ("max_deviation", e.max_deviation),
-        ("max_peak_speed", e.max_peak_speed),
-        ("max_peak_force", e.max_peak_force),
-        ("max_final_speed", e.max_final_speed),
-        ("min_distance_covered", e.min_distance_covered),
-        ("max_distance_covered", e.max_distance_covered),
-    ] {
-        if let Some(x) = value
-            && !(x.is_finite() && x >= 0.0)
-        {
-            bad(
-                format!("{key}.{name}"),
-                format!("must be a finite number ≥ 0, got {x}"),
-            );
+    if let Err(problems) = crate::expect::bounds(e) {
+        for (name, message) in problems {
+            bad(format!("{key}.{name}"), message);
         }
-    }
-    if let (Some(lo), Some(hi)) = (e.min_contacts, e.max_contacts)
-        && lo > hi
-    {
-        bad(
-            format!("{key}.min_contacts"),
-            format!("{lo} is more than max_contacts = {hi}"),
-        );
     }
 }
 
@@ -485,27 +457,7 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
 
 /// The first wall (described for a message) that a disc of radius `r` at `p` overlaps.
 fn blocking_wall(world: &World, p: [f64; 2], r: f64) -> Option<String> {
-    let outer = if world.walls_around {
-        outer_walls(world.size)
-    } else {
-        Vec::new()
-    };
-    let named = outer
-        .iter()
-        .map(|w| (w, "the outer wall".to_string()))
-        .chain(
-            world
-                .walls
-                .iter()
-                .enumerate()
-                .map(|(i, w)| (w, format!("walls.{i}"))),
-        );
-    for (wall, name) in named {
-        if let Some(shape) = wall_shape(wall)
-            && shape.distance_to_point(p[0], p[1]) < r
-        {
-            return Some(name);
-        }
-    }
-    None
+    named_walls(world)
+        .find(|(_, wall)| wall_shape(wall).is_some_and(|s| s.distance_to_point(p[0], p[1]) < r))
+        .map(|(name, _)| name)
 }

@@ -1,4 +1,6 @@
-//! What a run reports per agent (design page, "Metrics"), accumulated step by step.
+//! What a run reports per agent (design page, "Metrics"), accumulated step by step
+//! ([`Metrics`]) into a [`Summary`], whose fields are declared once with their units
+//! (`measure.rs`) and printed as a table or CSV from that declaration (`table.rs`).
 //!
 //! - `reached`: the final distance to the target is within the 5 % band of the initial one.
 //! - `settling_time`: the time at which the distance last entered the 5 % band and stayed
@@ -16,8 +18,14 @@
 //!   `lateral_reversals`, how often the motion across it reverses between excursions faster than
 //!   [`LATERAL_REVERSAL_SPEED`] (the narrow corridor effect is a stream of such reversals).
 
+mod measure;
+mod table;
+
 use nalgebra::Vector2;
 use serde::Serialize;
+
+pub use measure::{Kind, Measured, Metric, Value, measurements, metrics_of, values_of};
+pub use table::{csv, field as csv_field, table};
 
 use crate::field::Streamline;
 
@@ -28,61 +36,67 @@ pub const SETTLING_BAND: f64 = 0.05;
 /// that the jitter of a body moving straight is not counted as oscillation.
 pub const LATERAL_REVERSAL_SPEED: f64 = 0.05;
 
-/// One agent's summary, with the key names of `--json`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Summary {
-    /// The agent's name.
-    pub name: String,
-    /// Whether the final distance is within the settling band.
-    pub reached: bool,
-    /// Settling time, s; `None` if the agent never settled.
-    pub settling_time: Option<f64>,
-    /// Final distance to the target, m.
-    pub final_error: f64,
-    /// Number of contact starts.
-    pub contacts: usize,
-    /// Smallest distance from the agent's shape to any wall, m.
-    pub min_clearance: f64,
-    /// `δ_m`: largest distance from the dynamic to the kinematic path, m.
-    pub max_deviation: f64,
-    /// Length of the dynamic path, m.
-    pub path_length: f64,
-    /// Largest control force magnitude, N.
-    pub peak_force: f64,
-    /// Total variation of the control force, N.
-    pub control_variation: f64,
-    /// Largest speed, m/s.
-    pub peak_speed: f64,
-    /// Speed at the end of the run, m/s.
-    pub final_speed: f64,
-    /// Distance from the start at the world's `distance_at` time, m; `None` without
-    /// `distance_at`, or when the run ended before it.
-    pub distance_covered: Option<f64>,
-    /// RMS of the velocity across the start-to-target line over the run, m/s.
-    pub lateral_speed_rms: f64,
-    /// Reversals of the motion across the start-to-target line (between excursions faster than
-    /// [`LATERAL_REVERSAL_SPEED`]).
-    pub lateral_reversals: usize,
-    /// Numerical faults met during the run (all zero in a healthy run).
-    pub faults: Faults,
+crate::measured! {
+    /// One agent's summary, with the key names of `--json`. Each field is declared once here,
+    /// with its unit, the digits shown and its column in the printed table; the CSV of a sweep,
+    /// the table and the expectations a world file may state all read this declaration.
+    #[derive(Debug, Clone, PartialEq, Serialize)]
+    pub struct Summary {
+        /// The agent's name.
+        pub name: String,
+        /// Whether the final distance is within the settling band.
+        pub reached: bool [column("reached")],
+        /// Settling time, s; `None` if the agent never settled.
+        pub settling_time: Option<f64> [unit("s"), column("settle_s"), missing("never")],
+        /// Final distance to the target, m.
+        pub final_error: f64 [unit("m"), column("error_m")],
+        /// Number of contact starts.
+        pub contacts: usize [column("contacts")],
+        /// Smallest distance from the agent's shape to any wall, m.
+        pub min_clearance: f64 [unit("m"), column("clear_m")],
+        /// `δ_m`: largest distance from the dynamic to the kinematic path, m.
+        pub max_deviation: f64 [unit("m"), column("dev_m")],
+        /// Length of the dynamic path, m.
+        pub path_length: f64 [unit("m"), digits(2), column("path_m")],
+        /// Largest control force magnitude, N.
+        pub peak_force: f64 [unit("N"), digits(2), column("peak_N")],
+        /// Total variation of the control force, N.
+        pub control_variation: f64 [unit("N"), digits(2), column("var_N")],
+        /// Largest speed, m/s.
+        pub peak_speed: f64 [unit("m/s"), digits(2), column("vmax")],
+        /// Speed at the end of the run, m/s.
+        pub final_speed: f64 [unit("m/s")],
+        /// Distance from the start at the world's `distance_at` time, m; `None` without
+        /// `distance_at`, or when the run ended before it.
+        pub distance_covered: Option<f64> [unit("m"), missing("not measured (set distance_at within the duration)")],
+        /// RMS of the velocity across the start-to-target line over the run, m/s.
+        pub lateral_speed_rms: f64 [unit("m/s")],
+        /// Reversals of the motion across the start-to-target line (between excursions faster
+        /// than [`LATERAL_REVERSAL_SPEED`]).
+        pub lateral_reversals: usize,
+        /// Numerical faults met during the run (all zero in a healthy run).
+        pub faults: Faults,
+    }
 }
 
-/// Numerical faults of one agent's run (see `sim::faults`).
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
-pub struct Faults {
-    /// Steps in which the guidance was undefined: the gradient vanished or reversed from one
-    /// step to the next (the body is on a critical point, e.g. a saddle), the field was flat, or
-    /// the body was off the field. Not counted within two cells of the target.
-    pub guidance_lost_steps: usize,
-    /// Steps whose control force could not be given to Rapier (not finite in f32); zero was
-    /// applied instead.
-    pub rejected_forces: usize,
-    /// Times the body was pushed more than 1 cm into a wall.
-    pub penetrations: usize,
-    /// Steps with the body's centre outside the box.
-    pub left_box_steps: usize,
-    /// Whether Rapier's state of the body became non-finite (the body was then frozen).
-    pub non_finite_state: bool,
+crate::measured! {
+    /// Numerical faults of one agent's run (see `sim::faults`).
+    #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+    pub struct Faults {
+        /// Steps in which the guidance was undefined: the gradient vanished or reversed from
+        /// one step to the next (the body is on a critical point, e.g. a saddle), the field was
+        /// flat, or the body was off the field. Not counted within two cells of the target.
+        pub guidance_lost_steps: usize,
+        /// Steps whose control force could not be given to Rapier (not finite in f32); zero
+        /// was applied instead.
+        pub rejected_forces: usize,
+        /// Times the body was pushed more than 1 cm into a wall.
+        pub penetrations: usize,
+        /// Steps with the body's centre outside the box.
+        pub left_box_steps: usize,
+        /// Whether Rapier's state of the body became non-finite (the body was then frozen).
+        pub non_finite_state: bool,
+    }
 }
 
 impl Faults {

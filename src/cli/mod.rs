@@ -1,0 +1,117 @@
+//! The `nadf` commands, as library functions: `src/main.rs` only parses the command line
+//! (with the argument structs here) and dispatches. Each command prints what it reports to
+//! standard output and returns `Err(Failure)` when it cannot do its job; the one mapping from
+//! a failure to the process's exit status is [`Failure::exit_code`]:
+//!
+//! | status | meaning |
+//! |---|---|
+//! | 0 | success (and every `[expect]`ation held) |
+//! | 1 | the run finished but an `[expect]`ation failed |
+//! | 2 | bad input: a world file, an override, an output that cannot be written, or an intractable task |
+//! | 130 | interrupted with Ctrl-C |
+
+mod check;
+mod field;
+mod run;
+mod sweep;
+
+pub use check::{CheckArgs, check};
+pub use field::{FieldArgs, field};
+pub use run::{RunArgs, run};
+pub use sweep::{SweepArgs, sweep};
+
+use std::io::IsTerminal;
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::world::{Override, World, WorldFile};
+
+/// Why a command did not succeed.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Failure {
+    /// Bad input: a world file, an override, an output that cannot be written, an intractable
+    /// task. The message says what and where.
+    #[error("{0}")]
+    BadInput(String),
+    /// The run finished but some of its expectations failed (listed in the message).
+    #[error("{0}")]
+    Expectations(String),
+    /// Stopped by Ctrl-C.
+    #[error("{0}")]
+    Interrupted(String),
+}
+
+impl Failure {
+    /// The process's exit status for this failure.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Expectations(_) => 1,
+            Self::BadInput(_) => 2,
+            Self::Interrupted(_) => 130,
+        }
+    }
+}
+
+/// What every command shares: whether to draw progress bars, and the flag Ctrl-C sets.
+#[derive(Debug, Clone)]
+pub struct Console {
+    /// Draw progress bars on standard error.
+    pub progress: bool,
+    /// Set when Ctrl-C is pressed: long work stops after its current step.
+    pub interrupt: Arc<AtomicBool>,
+}
+
+impl Console {
+    /// Progress bars when standard error is a terminal outside CI, and one Ctrl-C handler
+    /// that sets [`Console::interrupt`] (a warning is printed if it cannot be installed).
+    pub fn new() -> Self {
+        let interrupt = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&interrupt);
+        if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+            eprintln!("warning: Ctrl-C will not stop a run cleanly: {e}");
+        }
+        Self {
+            progress: std::io::stderr().is_terminal() && std::env::var_os("CI").is_none(),
+            interrupt,
+        }
+    }
+
+    /// A progress bar of `len` steps in the given template, hidden without progress.
+    pub fn bar(&self, len: u64, template: &str) -> indicatif::ProgressBar {
+        if !self.progress {
+            return indicatif::ProgressBar::hidden();
+        }
+        let bar = indicatif::ProgressBar::new(len);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(template)
+                .expect("a valid template")
+                .progress_chars("=> "),
+        );
+        bar
+    }
+}
+
+impl Default for Console {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Reads and loads a world file with overrides, printing its warnings; every problem in it is
+/// bad input.
+fn load(path: &Path, overrides: &[Override]) -> Result<World, Failure> {
+    let file = WorldFile::read(path).map_err(|e| Failure::BadInput(e.to_string()))?;
+    let world = file
+        .load(overrides)
+        .map_err(|e| Failure::BadInput(e.to_string()))?;
+    for w in file.warnings(&world) {
+        eprintln!("warning: {w}");
+    }
+    Ok(world)
+}
+
+/// `error: FILE: MESSAGE`, bad input.
+fn bad_input(path: &Path, message: impl std::fmt::Display) -> Failure {
+    Failure::BadInput(format!("error: {}: {message}", path.display()))
+}

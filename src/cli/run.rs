@@ -1,0 +1,79 @@
+//! `nadf run`: simulate a world headlessly, write its recording, print its summary, check its
+//! expectations.
+
+use std::path::PathBuf;
+
+use super::{Console, Failure, bad_input, load};
+use crate::run::RunOptions;
+use crate::world::Override;
+
+/// The arguments of `nadf run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// The world file (TOML).
+    pub world: PathBuf,
+    /// The recording to write [default: WORLD_STEM.rrd in the current directory].
+    #[arg(short, long, value_name = "OUT.rrd")]
+    pub output: Option<PathBuf>,
+    /// Do not write a recording.
+    #[arg(long, conflicts_with = "output")]
+    pub no_record: bool,
+    /// Also write the summary as JSON to this file.
+    #[arg(long, value_name = "SUMMARY.json")]
+    pub json: Option<PathBuf>,
+    /// Override a world value by dotted path, array items by index
+    /// (e.g. --set agents.0.controller.b=0.7). Repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub overrides: Vec<Override>,
+}
+
+/// Runs the world to its duration and prints the summary; fails with the missed expectations.
+pub fn run(args: &RunArgs, console: &Console) -> Result<(), Failure> {
+    let path = &args.world;
+    let world = load(path, &args.overrides)?;
+    let recording = (!args.no_record).then(|| {
+        args.output.clone().unwrap_or_else(|| {
+            let stem = path
+                .file_stem()
+                .map_or_else(|| "world".into(), |s| s.to_owned());
+            PathBuf::from(stem).with_extension("rrd")
+        })
+    });
+    let options = RunOptions {
+        recording,
+        json: args.json.clone(),
+        progress: console.progress,
+        interrupt: Some(console.interrupt.clone()),
+    };
+    let report = crate::run::run(&world, &options).map_err(|e| bad_input(path, e))?;
+    print!("{}", report.table());
+    let wall = report.wall_time.as_secs_f64();
+    match &report.recording {
+        Some(rrd) => println!(
+            "wall time {wall:.2} s; recording: {} (open it with `rerun {}`)",
+            rrd.display(),
+            rrd.display()
+        ),
+        None => println!("wall time {wall:.2} s; no recording"),
+    }
+    if let Some(t) = report.interrupted_at {
+        return Err(Failure::Interrupted(format!(
+            "interrupted at t = {t:.2} s of {} s: the summary and the recording cover the run so far",
+            world.duration
+        )));
+    }
+    let mut failures = crate::expect::failures(&world, &report.agents);
+    failures.extend(crate::expect::pendulum_failures(&world, &report.pendulums));
+    if failures.is_empty() {
+        return Ok(());
+    }
+    let mut message = format!(
+        "{}: {} expectation(s) failed:",
+        path.display(),
+        failures.len()
+    );
+    for f in &failures {
+        message += &format!("\n  {f}");
+    }
+    Err(Failure::Expectations(message))
+}

@@ -1,0 +1,264 @@
+//! The preconditioner: the hierarchy of levels ([`Hierarchy`]) and one W-cycle over it —
+//! pre-smoothing and restriction, two visits of the next coarser level, prolongation and
+//! post-smoothing — with an exact solve on the coarsest level ([`Coarsest`]).
+
+use super::kernels::{dot, wide};
+use super::level::Level;
+use super::smoother::{Keep, keep_patterns};
+
+/// Smoothing sweeps before and after each coarse correction.
+const SWEEPS: usize = 2;
+/// Coarse-level visits per cycle: 1 is a V-cycle, 2 a W-cycle.
+const VISITS: usize = 2;
+/// A level with at most this many unknowns is solved exactly.
+const COARSEST: usize = 64;
+
+/// The exact solve of the coarsest level: a dense Cholesky factor of its matrix.
+pub struct Coarsest {
+    /// Padded index of each unknown.
+    cells: Vec<usize>,
+    /// Lower-triangular factor, row-major `n × n`; a non-positive pivot (which an SPD matrix
+    /// never has, but rounding could) leaves its unknown at 0.
+    factor: Vec<f64>,
+}
+
+impl Coarsest {
+    /// The factor of `level`'s matrix.
+    pub fn new(level: &Level) -> Self {
+        let cells: Vec<usize> = (0..level.ny)
+            .flat_map(|j| (0..level.nx).map(move |i| (i, j)))
+            .map(|(i, j)| level.pad(i, j))
+            .filter(|&k| level.active(k) != 0.0)
+            .collect();
+        let n = cells.len();
+        let mut a = vec![0.0f64; n * n];
+        for (r, &k) in cells.iter().enumerate() {
+            for (c, &m) in cells.iter().enumerate() {
+                a[r * n + c] = if k == m {
+                    f64::from(level.diag_at(k))
+                } else if m == k + 1 {
+                    -f64::from(level.east_at(k))
+                } else if k == m + 1 {
+                    -f64::from(level.east_at(m))
+                } else if m == k + level.stride {
+                    -f64::from(level.north_at(k))
+                } else if k == m + level.stride {
+                    -f64::from(level.north_at(m))
+                } else {
+                    0.0
+                };
+            }
+        }
+        // In-place Cholesky: a = L Lᵀ, L in the lower triangle.
+        for c in 0..n {
+            let mut pivot = a[c * n + c];
+            for p in 0..c {
+                pivot -= a[c * n + p] * a[c * n + p];
+            }
+            let pivot = if pivot > 0.0 { pivot.sqrt() } else { 0.0 };
+            a[c * n + c] = pivot;
+            for r in c + 1..n {
+                let mut v = a[r * n + c];
+                for p in 0..c {
+                    v -= a[r * n + p] * a[c * n + p];
+                }
+                a[r * n + c] = if pivot > 0.0 { v / pivot } else { 0.0 };
+            }
+        }
+        Self { cells, factor: a }
+    }
+
+    /// `x = A⁻¹ b` on the coarsest level.
+    fn solve(&self, x: &mut [f32], b: &[f32], scratch: &mut Vec<f64>) {
+        let n = self.cells.len();
+        let l = &self.factor;
+        scratch.clear();
+        scratch.extend(self.cells.iter().map(|&k| f64::from(b[k])));
+        let y = scratch;
+        for r in 0..n {
+            let mut v = y[r];
+            for p in 0..r {
+                v -= l[r * n + p] * y[p];
+            }
+            y[r] = if l[r * n + r] > 0.0 {
+                v / l[r * n + r]
+            } else {
+                0.0
+            };
+        }
+        for r in (0..n).rev() {
+            let mut v = y[r];
+            for p in r + 1..n {
+                v -= l[p * n + r] * y[p];
+            }
+            y[r] = if l[r * n + r] > 0.0 {
+                v / l[r * n + r]
+            } else {
+                0.0
+            };
+        }
+        for (&k, &v) in self.cells.iter().zip(y.iter()) {
+            x[k] = v as f32;
+        }
+    }
+}
+
+/// The hierarchy and its work vectors.
+pub struct Hierarchy {
+    /// The levels, finest first.
+    pub levels: Vec<Level>,
+    coarsest: Coarsest,
+    /// Per level: solution and right-hand side.
+    pub work: Vec<[Vec<f32>; 2]>,
+    /// One row of relaxed values.
+    row: Vec<f32>,
+    /// One row of residuals, or of prolonged corrections.
+    residual: Vec<f32>,
+    /// Which cells a relaxation keeps.
+    keep: Keep,
+    /// The coarsest solve's scratch.
+    scratch: Vec<f64>,
+}
+
+impl Hierarchy {
+    /// The hierarchy of the `nx × ny` grid's `unknown` cells.
+    pub fn new(nx: usize, ny: usize, unknown: &[bool]) -> Self {
+        let mut levels = vec![Level::finest(nx, ny, unknown)];
+        loop {
+            let last = levels.last().expect("one level");
+            if last.unknowns <= COARSEST || (last.nx <= 2 && last.ny <= 2) {
+                break;
+            }
+            let coarse = last.coarsen();
+            levels.push(coarse);
+        }
+        let coarsest = Coarsest::new(levels.last().expect("one level"));
+        let work = levels
+            .iter()
+            .map(|l| [vec![0.0; l.len()], vec![0.0; l.len()]])
+            .collect();
+        Self {
+            row: vec![0.0; nx + 2],
+            residual: vec![0.0; nx + 2],
+            keep: keep_patterns(nx),
+            levels,
+            coarsest,
+            work,
+            scratch: Vec::new(),
+        }
+    }
+
+    /// `z ≈ A⁻¹ r`: one cycle from a zero guess. The fine right-hand side is `work[0][1]`,
+    /// which the caller fills; the result is left in `work[0][0]`. Returns `z · r`.
+    pub fn precondition(&mut self) -> f64 {
+        self.cycle(0, true)
+    }
+
+    /// One cycle on level `l`, from 0 (`zero_start`, whatever `x` holds) or from the current
+    /// `x` of that level; returns `x · b` of the result on the finest level, else 0.
+    fn cycle(&mut self, l: usize, zero_start: bool) -> f64 {
+        if l + 1 == self.levels.len() {
+            let [x, b] = &mut self.work[l];
+            self.coarsest.solve(x, b, &mut self.scratch);
+            return if l == 0 { dot(x, b) } else { 0.0 };
+        }
+        self.smooth_and_restrict(l, zero_start);
+        for visit in 0..VISITS {
+            self.cycle(l + 1, visit == 0);
+        }
+        self.prolong_and_smooth(l)
+    }
+
+    /// Pre-smoothing on level `l` (red then black, `SWEEPS` times), then its residual summed
+    /// into level `l + 1`'s right-hand side (each coarse cell sums its children's). One
+    /// wavefront does it all.
+    fn smooth_and_restrict(&mut self, l: usize, zero_start: bool) {
+        let (fine_work, coarse_work) = self.work.split_at_mut(l + 1);
+        let [x, b] = &mut fine_work[l];
+        let (level, coarse) = (&self.levels[l], &self.levels[l + 1]);
+        let coarse_b = &mut coarse_work[0][1];
+        let (t, residual, keep) = (&mut self.row, &mut self.residual, &self.keep);
+        let colours = [[0, 1]; SWEEPS];
+        let colours = colours.as_flattened();
+        wide(
+            #[inline(always)]
+            || {
+                level.sweep(
+                    colours,
+                    zero_start,
+                    (x, b),
+                    (t, keep),
+                    |_, _| {},
+                    #[inline(always)]
+                    |j, x| {
+                        let cols = level.span(j);
+                        let residual = &mut residual[..cols.len()];
+                        level.residual_row(j, x, b, residual);
+                        let base = coarse.pad(cols.start / 2, j / 2);
+                        let parents = &mut coarse_b[base..base + cols.len().div_ceil(2)];
+                        // The even row of a pair sets its parents, the odd one adds to them.
+                        let first = if j % 2 == 0 { 0.0 } else { 1.0 };
+                        let pairs = residual.chunks_exact(2);
+                        if let (Some(r), Some(c)) = (pairs.remainder().first(), parents.last_mut())
+                        {
+                            *c = first * *c + r;
+                        }
+                        for (c, r) in parents.iter_mut().zip(pairs) {
+                            *c = first * *c + (r[0] + r[1]);
+                        }
+                    },
+                )
+            },
+        );
+    }
+
+    /// Every active cell of level `l` gets its coarse cell's correction; then post-smoothing
+    /// (black then red, `SWEEPS` times). One wavefront does it all. Returns `x · b` on the
+    /// finest level (CG needs it, and each row is still in cache when it is final), else 0.
+    fn prolong_and_smooth(&mut self, l: usize) -> f64 {
+        let (level, coarse) = (&self.levels[l], &self.levels[l + 1]);
+        let (fine_work, coarse_work) = self.work.split_at_mut(l + 1);
+        let [x, b] = &mut fine_work[l];
+        let correction = &coarse_work[0][0];
+        let (t, expanded, keep) = (&mut self.row, &mut self.residual, &self.keep);
+        let colours = [[1, 0]; SWEEPS];
+        let colours = colours.as_flattened();
+        let mut xb = 0.0;
+        wide(
+            #[inline(always)]
+            || {
+                level.sweep(
+                    colours,
+                    false,
+                    (x, b),
+                    (t, keep),
+                    #[inline(always)]
+                    |j, x| {
+                        let cols = level.span(j);
+                        let (start, n) = (level.pad(cols.start, j), cols.len());
+                        let base = coarse.pad(cols.start / 2, j / 2);
+                        let parents = &correction[base..base + n.div_ceil(2)];
+                        let expanded = &mut expanded[..2 * parents.len()];
+                        for (pair, c) in expanded.chunks_exact_mut(2).zip(parents) {
+                            pair[0] = *c;
+                            pair[1] = *c;
+                        }
+                        let cells = &mut x[start..start + n];
+                        let active = &level.inv_diag[start..start + n];
+                        for ((x, a), c) in cells.iter_mut().zip(active).zip(&expanded[..n]) {
+                            *x += if *a != 0.0 { *c } else { 0.0 };
+                        }
+                    },
+                    #[inline(always)]
+                    |j, x| {
+                        if l == 0 {
+                            let (k, n) = level.row(j);
+                            xb += dot(&x[k..k + n], &b[k..k + n]);
+                        }
+                    },
+                )
+            },
+        );
+        xb
+    }
+}

@@ -1,0 +1,233 @@
+//! The conjugate gradient driver: the vectors in f64 (and the search direction in f32), the
+//! initial residual, the iteration with one W-cycle per step as the preconditioner, and the
+//! copy of the solution back onto the grid.
+
+use super::Stats;
+use super::cycle::Hierarchy;
+use super::kernels::{Neighbourhood, dot, for_cycle, wide};
+use super::level::Level;
+use crate::field::Grid;
+
+/// The CG vectors on the fine level's padded layout. The search direction is kept in f32 as
+/// `q = scale · p`, scaled like the cycle's output it is made from (see [`Krylov::iterate`]);
+/// the solution `x` and the residual `r` stay in f64, since they carry the solution's precision.
+pub struct Krylov {
+    x: Vec<f64>,
+    r: Vec<f64>,
+    q: Vec<f32>,
+    /// One row of `A q`.
+    row: Vec<f64>,
+    /// `‖b‖`, the norm the residual is measured against.
+    norm_b: f64,
+    /// `r · r`.
+    rr: f64,
+}
+
+impl Krylov {
+    /// The starting guess (the unknown cells of `values`), the right-hand side `b` (the sum of
+    /// each unknown cell's fixed neighbours; cells outside the grid are its ring of zeros) and
+    /// the initial residual `r = b − A x`, on the padded layout of the fine level.
+    pub fn start(fine: &Level, grid: &Grid, unknown: &[bool], values: &[f64]) -> Self {
+        let (nx, ny, stride) = (grid.nx, grid.ny, fine.stride);
+        let n = fine.len();
+        // `fixed` holds the Dirichlet values and then becomes the residual: fresh memory costs
+        // page faults.
+        let mut x = vec![0.0; n];
+        let mut fixed = vec![0.0; n];
+        for j in 0..ny {
+            let (k, row) = (fine.pad(0, j), j * nx..(j + 1) * nx);
+            for (((x, f), v), u) in x[k..k + nx]
+                .iter_mut()
+                .zip(&mut fixed[k..k + nx])
+                .zip(&values[row.clone()])
+                .zip(&unknown[row])
+            {
+                (*x, *f) = if *u { (*v, 0.0) } else { (0.0, *v) };
+            }
+        }
+        // r = b − A x row by row, trailing two rows behind so that `fixed` (read up to a row
+        // ahead) can be overwritten with r.
+        let (mut bb, mut rr) = (0.0, 0.0);
+        let mut rows = [vec![0.0; nx], vec![0.0; nx]];
+        for j in 0..ny + 2 {
+            if j >= 2 {
+                let k = fine.pad(0, j - 2);
+                fixed[k..k + nx].copy_from_slice(&rows[j % 2]);
+            }
+            if j < ny {
+                let k = fine.pad(0, j);
+                let f = Neighbourhood::of(&fixed, k, nx, stride);
+                let u = Neighbourhood::of(&x, k, nx, stride);
+                let d = &fine.inv_diag[k..k + nx];
+                let row = &mut rows[j % 2];
+                let mut b_row = 0.0;
+                for i in 0..nx {
+                    let (b, r) = if d[i] != 0.0 {
+                        let b = f.west[i] + f.east[i] + f.up[i] + f.down[i];
+                        (
+                            b,
+                            b - (4.0 * u.mid[i] - u.west[i] - u.east[i] - u.up[i] - u.down[i]),
+                        )
+                    } else {
+                        (0.0, 0.0)
+                    };
+                    b_row += b * b;
+                    row[i] = r;
+                }
+                bb += b_row;
+                rr += dot(row, row);
+            }
+        }
+        Self {
+            x,
+            r: fixed,
+            q: vec![0.0; n],
+            row: vec![0.0; nx],
+            norm_b: bb.sqrt(),
+            rr,
+        }
+    }
+
+    /// `‖r‖ / ‖b‖` (`‖r‖` when `b` is 0).
+    fn relative(&self) -> f64 {
+        if self.norm_b > 0.0 {
+            self.rr.sqrt() / self.norm_b
+        } else {
+            self.rr.sqrt()
+        }
+    }
+
+    /// Preconditioned CG until the relative residual is at most `tolerance` or
+    /// `max_iterations` are done: `z = M r`, `p = z + β p`, `x += α p`, `r −= α A p`,
+    /// `α = r·z / p·A p`, `β = r_next·z_next / r·z`.
+    ///
+    /// The cycle's right-hand side `r` is scaled by `scale`, about `1 / ‖r‖`, so that f32 sees
+    /// no extreme values. The cycle then returns `scale · z`, and the direction is kept as
+    /// `q = scale · p`, which is also O(1): `p · A p = q · A q / scale²`, and the next
+    /// `q = scale' · z' + β (scale' / scale) q`.
+    pub fn iterate(&mut self, h: &mut Hierarchy, tolerance: f64, max_iterations: usize) -> Stats {
+        let mut stats = Stats {
+            iterations: 0,
+            relative_residual: self.relative(),
+        };
+        if stats.relative_residual <= tolerance {
+            return stats;
+        }
+        let mut scale = 1.0 / self.rr.sqrt();
+        let r = &self.r;
+        wide(
+            #[inline(always)]
+            || {
+                for (o, r) in h.work[0][1].iter_mut().zip(r) {
+                    *o = for_cycle(*r, scale);
+                }
+            },
+        );
+        let mut rz = h.precondition() / (scale * scale);
+        let mut gamma = 0.0;
+        while stats.iterations < max_iterations {
+            stats.iterations += 1;
+            let pap = self.direct(&h.levels[0], &h.work[0][0], gamma) / (scale * scale);
+            if pap.is_nan() || pap <= 0.0 {
+                break;
+            }
+            let alpha = rz / pap;
+            let next_scale = 1.0 / self.rr.sqrt();
+            self.rr = self.step(&h.levels[0], alpha / scale, next_scale, &mut h.work[0][1]);
+            stats.relative_residual = self.relative();
+            if stats.relative_residual <= tolerance {
+                break;
+            }
+            let rz_next = h.precondition() / (next_scale * next_scale);
+            gamma = (rz_next / rz * next_scale / scale) as f32;
+            (rz, scale) = (rz_next, next_scale);
+        }
+        stats
+    }
+
+    /// Writes the solution into the unknown cells of `values`.
+    pub fn copy_out(&self, fine: &Level, grid: &Grid, unknown: &[bool], values: &mut [f64]) {
+        let nx = grid.nx;
+        for j in 0..grid.ny {
+            let (k, row) = (fine.pad(0, j), j * nx..(j + 1) * nx);
+            for ((v, x), u) in values[row.clone()]
+                .iter_mut()
+                .zip(&self.x[k..k + nx])
+                .zip(&unknown[row])
+            {
+                if *u {
+                    *v = *x;
+                }
+            }
+        }
+    }
+
+    /// The new direction `q = z + γ q` and its curvature `q · A q`: one pass, `A q` trailing a
+    /// row behind the rows it reads. (`q` is 0 on inactive cells, so they add nothing to the
+    /// sum whatever the stencil gives there.)
+    fn direct(&mut self, level: &Level, z: &[f32], gamma: f32) -> f64 {
+        let Self { q, row, .. } = self;
+        wide(
+            #[inline(always)]
+            || {
+                let mut qaq = 0.0;
+                for j in 0..level.ny + 1 {
+                    if j < level.ny {
+                        let (k, n) = level.row(j);
+                        for (q, z) in q[k..k + n].iter_mut().zip(&z[k..k + n]) {
+                            *q = z + gamma * *q;
+                        }
+                    }
+                    if j > 0 {
+                        apply_row(level, q, j - 1, row);
+                        let (k, n) = level.row(j - 1);
+                        qaq += dot(&q[k..k + n], &row[..n]);
+                    }
+                }
+                qaq
+            },
+        )
+    }
+
+    /// The step `x += c q`, `r −= c A q` (on the active cells), the new `r · r`, and
+    /// `out = r · scale` in f32 (the next cycle's right-hand side): one pass.
+    fn step(&mut self, level: &Level, c: f64, scale: f64, out: &mut [f32]) -> f64 {
+        let Self { x, r, q, row, .. } = self;
+        wide(
+            #[inline(always)]
+            || {
+                let mut rr = 0.0;
+                for j in 0..level.ny {
+                    apply_row(level, q, j, row);
+                    let (k, n) = level.row(j);
+                    let (x, r, q) = (&mut x[k..k + n], &mut r[k..k + n], &q[k..k + n]);
+                    let (d, out) = (&level.inv_diag[k..k + n], &mut out[k..k + n]);
+                    for i in 0..n {
+                        x[i] += c * f64::from(q[i]);
+                        r[i] -= if d[i] != 0.0 { c * row[i] } else { 0.0 };
+                        out[i] = for_cycle(r[i], scale);
+                    }
+                    rr += dot(r, r);
+                }
+                rr
+            },
+        )
+    }
+}
+
+/// `A q` on row `j` of the fine level, in f64, into `out`: the 5-point stencil on every cell,
+/// so it is `A q` on the active cells only (`q` is 0 on the others). `q` holds f32 values, so
+/// the sums are exact in f64.
+#[inline(always)]
+fn apply_row(level: &Level, q: &[f32], j: usize, out: &mut [f64]) {
+    let (k, n) = level.row(j);
+    let q = Neighbourhood::of(q, k, n, level.stride);
+    let out = &mut out[..n];
+    for i in 0..n {
+        out[i] = 4.0 * f64::from(q.mid[i])
+            - f64::from(q.west[i])
+            - f64::from(q.east[i])
+            - f64::from(q.up[i])
+            - f64::from(q.down[i]);
+    }
+}

@@ -1,0 +1,234 @@
+//! The agents: each one's field, guidance arrows, kinematic path, start and target (static);
+//! its body, velocity, force, contacts, trail, events and sensed walls per step; and its time
+//! series.
+
+use rerun::RecordingStream;
+
+use super::colormap;
+use super::names::{AGENT_SERIES, AgentPaths, plot};
+use super::palette;
+use super::world::f32x2;
+use crate::sim::{AgentRun, AgentState, Simulation};
+
+/// Steps between two updates of the trail (which is re-logged whole).
+const TRAIL_EVERY: usize = 25;
+/// Most points in a logged trail: a longer one is thinned evenly (its last point kept), so a
+/// long run's recording grows linearly, not quadratically.
+const TRAIL_POINTS: usize = 2000;
+/// Arrows shown per side of the box in the guidance arrow field.
+const GUIDANCE_ARROWS: usize = 24;
+/// Length of a velocity arrow per m/s, m.
+const VELOCITY_SCALE: f32 = 0.5;
+/// Length of a force arrow per N, m.
+const FORCE_SCALE: f32 = 0.5;
+
+/// Logs each agent's field, guidance, kinematic path, start, target and series' labels
+/// (static).
+pub fn log_setup(
+    rec: &RecordingStream,
+    sim: &Simulation,
+) -> Result<(), rerun::RecordingStreamError> {
+    for run in &sim.agents {
+        let paths = AgentPaths::of(&run.agent.name);
+        if let Some(field) = run.field.harmonic() {
+            let grid = *field.grid();
+            let (image, resolution) = colormap::potential_image(field);
+            rec.log_static(
+                paths.potential.as_str(),
+                &rerun::Transform3D::from_translation_scale(
+                    [grid.origin[0] as f32, grid.origin[1] as f32, 0.0],
+                    rerun::Scale3D::from([grid.cell as f32, grid.cell as f32, 1.0]),
+                ),
+            )?;
+            rec.log_static(
+                paths.potential.as_str(),
+                &rerun::Image::from_rgb24(image, resolution).with_draw_order(-10.0),
+            )?;
+        }
+        let (origins, vectors) = guidance_arrows(sim, run);
+        rec.log_static(
+            paths.guidance,
+            &rerun::Arrows2D::from_vectors(vectors)
+                .with_origins(origins)
+                .with_colors([palette::rerun_alpha(
+                    palette::GUIDANCE,
+                    palette::GUIDANCE_ALPHA,
+                )]),
+        )?;
+        let path: Vec<[f32; 2]> = run.kinematic.points.iter().map(|p| f32x2(*p)).collect();
+        rec.log_static(
+            paths.kinematic_path,
+            &rerun::LineStrips2D::new([path])
+                .with_colors([palette::rerun(palette::KINEMATIC)])
+                .with_radii([0.02]),
+        )?;
+        rec.log_static(
+            paths.target,
+            &rerun::Points2D::new([f32x2(run.agent.target)])
+                .with_radii([0.1])
+                .with_colors([palette::rerun(palette::TARGET)]),
+        )?;
+        rec.log_static(
+            paths.start,
+            &rerun::Points2D::new([f32x2(run.agent.start)])
+                .with_radii([0.06])
+                .with_colors([palette::rerun(palette::START)]),
+        )?;
+        for series in AGENT_SERIES.iter().filter(|s| (s.shown)(&run.agent)) {
+            rec.log_static(
+                plot(&run.agent.name, series.key),
+                &rerun::SeriesLines::new().with_names([series.label]),
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// The agents' trails so far, re-logged whole every [`TRAIL_EVERY`] steps.
+#[derive(Default)]
+pub struct Trails {
+    points: Vec<Vec<[f32; 2]>>,
+    steps: usize,
+}
+
+impl Trails {
+    /// Logs each agent's state after a step; `last` is the run's last step (the trail is then
+    /// logged whatever the count).
+    pub fn log_step(
+        &mut self,
+        rec: &RecordingStream,
+        agents: &[AgentRun],
+        states: &[AgentState],
+        last: bool,
+    ) -> Result<(), rerun::RecordingStreamError> {
+        self.steps += 1;
+        self.points.resize(agents.len(), Vec::new());
+        for ((run, state), trail) in agents.iter().zip(states).zip(&mut self.points) {
+            let paths = AgentPaths::of(&run.agent.name);
+            let p = f32x2(state.position.into());
+            log_body(rec, &paths, run, state, p)?;
+            for series in AGENT_SERIES.iter().filter(|s| (s.shown)(&run.agent)) {
+                rec.log(
+                    plot(&run.agent.name, series.key),
+                    &rerun::Scalars::single((series.value)(&run.agent, state)),
+                )?;
+            }
+            trail.push(p);
+            if self.steps % TRAIL_EVERY == 1 || last {
+                let stride = trail.len().div_ceil(TRAIL_POINTS);
+                let mut points: Vec<[f32; 2]> = trail.iter().step_by(stride).copied().collect();
+                if (trail.len() - 1) % stride != 0 {
+                    points.push(p);
+                }
+                rec.log(
+                    paths.trail,
+                    &rerun::LineStrips2D::new([points])
+                        .with_colors([palette::rerun(palette::BODY)])
+                        .with_radii([0.015]),
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The body at `p`, its arrows, contacts, events and sensed walls.
+fn log_body(
+    rec: &RecordingStream,
+    paths: &AgentPaths,
+    run: &AgentRun,
+    state: &AgentState,
+    p: [f32; 2],
+) -> Result<(), rerun::RecordingStreamError> {
+    let colour = if state.contact_points.is_empty() {
+        palette::BODY
+    } else {
+        palette::TOUCHING
+    };
+    rec.log(
+        paths.body.as_str(),
+        &rerun::Points2D::new([p])
+            .with_radii([run.agent.radius as f32])
+            .with_colors([palette::rerun(colour)]),
+    )?;
+    for (path, vector, scale, colour) in [
+        (
+            &paths.velocity,
+            state.velocity,
+            VELOCITY_SCALE,
+            palette::VELOCITY,
+        ),
+        (&paths.force, state.force, FORCE_SCALE, palette::FORCE),
+    ] {
+        rec.log(
+            path.as_str(),
+            &rerun::Arrows2D::from_vectors([[vector.x as f32 * scale, vector.y as f32 * scale]])
+                .with_origins([p])
+                .with_colors([palette::rerun(colour)]),
+        )?;
+    }
+    let contacts: Vec<[f32; 2]> = state
+        .contact_points
+        .iter()
+        .map(|c| f32x2((*c).into()))
+        .collect();
+    rec.log(
+        paths.contacts.as_str(),
+        &rerun::Points2D::new(contacts)
+            .with_radii([0.06])
+            .with_colors([palette::rerun(palette::CONTACT)]),
+    )?;
+    for (messages, level) in [
+        (&state.events, rerun::TextLogLevel::WARN),
+        (&state.notes, rerun::TextLogLevel::INFO),
+    ] {
+        for message in messages {
+            rec.log(
+                paths.events.as_str(),
+                &rerun::TextLog::new(message.as_str()).with_level(level),
+            )?;
+        }
+    }
+    if let Some(sensed) = &state.sensed_walls {
+        rec.log(
+            paths.sensed_walls.as_str(),
+            &rerun::Points2D::new(sensed.iter().map(|p| f32x2(*p)))
+                .with_radii([0.025])
+                .with_colors([palette::rerun_alpha(palette::SENSED, palette::SENSED_ALPHA)]),
+        )?;
+    }
+    Ok(())
+}
+
+/// A sparse field of unit guidance arrows `-∇V/|∇V|`: at reachable cells of a harmonic field,
+/// at the free points of a regular lattice for an attractive-repulsive one.
+fn guidance_arrows(sim: &Simulation, run: &AgentRun) -> (Vec<[f32; 2]>, Vec<[f32; 2]>) {
+    let [w, h] = sim.world.size;
+    let spacing = (w.max(h) / GUIDANCE_ARROWS as f64).min(w.min(h) / 4.0);
+    let length = 0.6 * spacing;
+    let free = |c: [f64; 2]| match run.field.harmonic() {
+        Some(field) => field
+            .grid()
+            .cell_of(c)
+            .is_some_and(|(i, j)| field.sampler.reachable_cells()[field.grid().index(i, j)]),
+        None => {
+            crate::sim::signed_clearance(&sim.walls, nalgebra::Vector2::from(c), run.agent.radius)
+                > 0.0
+        }
+    };
+    let (mut origins, mut vectors) = (Vec::new(), Vec::new());
+    let (nx, ny) = ((w / spacing) as usize, (h / spacing).max(1.0) as usize);
+    for j in 0..ny {
+        for i in 0..nx {
+            let c = [(i as f64 + 0.5) * spacing, (j as f64 + 0.5) * spacing];
+            if !free(c) {
+                continue;
+            }
+            if let Some(u) = run.field.gradient(c).and_then(|g| crate::control::unit(&g)) {
+                origins.push(f32x2(c));
+                vectors.push(f32x2([-u.x * length, -u.y * length]));
+            }
+        }
+    }
+    (origins, vectors)
+}

@@ -1,0 +1,51 @@
+//! The colours of everything drawn: in the recording and in the pictures `nadf field` writes.
+
+/// An RGB colour.
+pub type Rgb = [u8; 3];
+
+/// The box's outline.
+pub const BOX: Rgb = [120, 120, 120];
+/// The walls' outlines, a pendulum's pivot.
+pub const WALL: Rgb = [230, 230, 230];
+/// A body, its trail, a pendulum's bob.
+pub const BODY: Rgb = [255, 170, 40];
+/// A body that touches something.
+pub const TOUCHING: Rgb = [255, 40, 40];
+/// Where a body touches something.
+pub const CONTACT: Rgb = [255, 0, 0];
+/// Velocity arrows, the kinematic path.
+pub const VELOCITY: Rgb = [80, 200, 255];
+/// The kinematic path (the streamline from the start).
+pub const KINEMATIC: Rgb = [80, 200, 255];
+/// Control force arrows.
+pub const FORCE: Rgb = [255, 90, 200];
+/// Targets.
+pub const TARGET: Rgb = [80, 255, 120];
+/// Starts.
+pub const START: Rgb = [255, 255, 255];
+/// A pendulum's rod.
+pub const ROD: Rgb = [200, 200, 200];
+/// Guidance arrows and streamlines (translucent in the recording).
+pub const GUIDANCE: Rgb = [255, 255, 255];
+/// Opacity of the guidance arrows.
+pub const GUIDANCE_ALPHA: u8 = 110;
+/// Streamlines in a field picture.
+pub const STREAMLINE: Rgb = [225, 225, 225];
+/// Walls as a sensor saw them (translucent).
+pub const SENSED: Rgb = [255, 80, 80];
+/// Opacity of the sensed walls.
+pub const SENSED_ALPHA: u8 = 160;
+/// Blocked cells of a field image.
+pub const BLOCKED: Rgb = [70, 70, 70];
+/// Free cells of a field image from which the target cannot be reached.
+pub const UNREACHABLE: Rgb = [0, 0, 0];
+
+/// A palette colour for Rerun.
+pub fn rerun(c: Rgb) -> rerun::Color {
+    rerun::Color::from_rgb(c[0], c[1], c[2])
+}
+
+/// A palette colour for Rerun with opacity `alpha`.
+pub fn rerun_alpha(c: Rgb, alpha: u8) -> rerun::Color {
+    rerun::Color::from_unmultiplied_rgba(c[0], c[1], c[2], alpha)
+}

@@ -1,0 +1,439 @@
+//! One agent's life in a step, in the order the step loop calls it:
+//!
+//! 1. [`AgentRun::plan`]: read the body's state from Rapier, take a sensor reading if one is
+//!    due, and decide whether the field must be rebuilt (a reading, or a replan with the other
+//!    agents where they are now).
+//! 2. [`AgentRun::resolve`]: re-solve a harmonic field that is due. It reads only the agent's
+//!    own plan and last field, so the loop runs it for all agents in parallel.
+//! 3. [`AgentRun::apply`]: install the new field, compute the control force from the guidance
+//!    and the state, and give it to Rapier (after resetting the body's forces: Rapier's user
+//!    forces persist across steps).
+//! 4. [`AgentRun::observe`]: after Rapier's step, read the state back, count contact starts,
+//!    watch for faults, update the metrics, and report the step as an [`AgentState`].
+//!
+//! What a step produces along the way (fault events, control notes, the sensed walls) is kept
+//! in the agent until `observe` hands it out.
+
+use std::collections::HashSet;
+
+use nalgebra::Vector2;
+use rapier2d::prelude::{ColliderHandle, PhysicsWorld, RigidBodyHandle};
+
+use super::faults::{FaultMonitor, Observation};
+use super::physics::{self, from_rapier, to_rapier};
+use super::{CONTACT_TOLERANCE, Sensor, signed_clearance};
+use crate::control::{ControlInput, ControlOutput, Controller, unit};
+use crate::field::{Disc, FieldError, GuidanceField, HarmonicField, Streamline};
+use crate::metrics::{Metrics, Summary};
+use crate::world::{Agent, WallShape, World};
+
+/// One agent in a running simulation.
+pub struct AgentRun {
+    /// The agent as the world file describes it.
+    pub agent: Agent,
+    /// Its guidance field: of the true walls, or of the last sensed walls with a sensor (and
+    /// the other agents where they were at the last replan).
+    pub field: GuidanceField,
+    /// Its wall sensor, if it senses the walls with noise.
+    pub sensor: Option<Sensor>,
+    /// Its kinematic path (the streamline from its start).
+    pub kinematic: Streamline,
+    /// Its controller.
+    pub controller: Controller<2>,
+    /// Its metrics so far.
+    pub metrics: Metrics,
+    /// Its numerical faults so far.
+    pub faults: FaultMonitor,
+    body: RigidBodyHandle,
+    collider: ColliderHandle,
+    /// The colliders it touched after the last step.
+    touching: HashSet<ColliderHandle>,
+    /// Set once its state became non-finite: no control from then on.
+    frozen: bool,
+    /// Whether the last rebuild of its field failed (noted once until one succeeds).
+    rebuild_failed: bool,
+    /// The last sensor reading: how far each wall is sensed outside its true position, m.
+    offsets: Vec<f64>,
+    /// Replans so far (the first field counts as one).
+    replans: usize,
+    /// What the current step has produced so far.
+    log: StepLog,
+}
+
+/// What one step produces for the recording, collected from `plan` to `observe`.
+#[derive(Default)]
+struct StepLog {
+    control: Option<ControlOutput<2>>,
+    events: Vec<String>,
+    notes: Vec<String>,
+    sensed_walls: Option<Vec<[f64; 2]>>,
+}
+
+/// An agent's part of a step, read before any field is re-solved.
+pub struct Plan {
+    /// Position at the start of the step.
+    x: Vector2<f64>,
+    /// Velocity at the start of the step.
+    v: Vector2<f64>,
+    /// Whether its sensor took a reading this step.
+    sensed_now: bool,
+    /// The other agents' discs.
+    others: Vec<Disc>,
+    /// Whether its field is rebuilt this step (a harmonic one is re-solved, in parallel).
+    rebuild: bool,
+}
+
+/// What happened to one agent in the last step, for recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AgentState {
+    /// Position, m.
+    pub position: Vector2<f64>,
+    /// Velocity, m/s.
+    pub velocity: Vector2<f64>,
+    /// The control force applied during the step, N.
+    pub force: Vector2<f64>,
+    /// Distance to the target, m.
+    pub distance: f64,
+    /// Speed along the guidance, `-uᵀv` with `u = ∇V/|∇V|` (the paper's "radial speed": the
+    /// component of motion along the radial basis of the field's coordinates, figure 12), m/s.
+    pub radial_speed: f64,
+    /// The potential `V` at the position.
+    pub potential: f64,
+    /// Distance from the agent's disc to the nearest wall, m.
+    pub clearance: f64,
+    /// Points where the agent touches something, m.
+    pub contact_points: Vec<Vector2<f64>>,
+    /// Whether the clamping control acted in this step.
+    pub clamping: bool,
+    /// Whether the speed limit acted in this step.
+    pub speed_limited: bool,
+    /// The bias β after this step, N (with the bias option).
+    pub beta: Option<Vector2<f64>>,
+    /// The configuration-space boundary of the walls sensed in this step (the centres of
+    /// blocked cells next to free ones), m; `None` when no reading was taken.
+    pub sensed_walls: Option<Vec<[f64; 2]>>,
+    /// Faults that started in this step, as messages.
+    pub events: Vec<String>,
+    /// Control events of this step (bias updates, sensing), as messages.
+    pub notes: Vec<String>,
+}
+
+impl AgentRun {
+    /// Puts the agent at `index` of `world` into `physics`, guided by `field`.
+    pub(super) fn new(
+        world: &World,
+        index: usize,
+        field: GuidanceField,
+        physics: &mut PhysicsWorld,
+    ) -> Self {
+        let agent = &world.agents[index];
+        let kinematic = field.streamline(agent.start, 4.0 * (world.size[0] + world.size[1]));
+        let (body, collider) = physics::insert_agent(physics, agent);
+        Self {
+            controller: Controller::from_settings(
+                &agent.controller,
+                world.field.guidance,
+                agent.mass,
+            ),
+            metrics: Metrics::new(&agent.name, agent.start, agent.target, world.distance_at),
+            agent: agent.clone(),
+            field,
+            sensor: agent
+                .sensor
+                .map(|settings| Sensor::new(settings, world.seed, index)),
+            kinematic,
+            faults: FaultMonitor::default(),
+            body,
+            collider,
+            touching: HashSet::new(),
+            frozen: false,
+            rebuild_failed: false,
+            offsets: Vec::new(),
+            replans: 1,
+            log: StepLog::default(),
+        }
+    }
+
+    /// Its summary so far.
+    pub fn summary(&self) -> Summary {
+        self.metrics.summary(&self.kinematic, &self.faults.faults)
+    }
+
+    /// Its disc where it is now (where it last was, if Rapier's position is not finite): an
+    /// obstacle in the other agents' fields.
+    pub(super) fn disc(&self, physics: &PhysicsWorld) -> Disc {
+        let p = from_rapier(physics.bodies[self.body].translation());
+        Disc {
+            center: if p.iter().all(|c| c.is_finite()) {
+                p.into()
+            } else {
+                self.last_position().into()
+            },
+            radius: self.agent.radius,
+        }
+    }
+
+    /// Step 1: reads the state, takes a sensor reading of the `walls` if one is due at `time`
+    /// (s), and decides whether the field is rebuilt with the `others` where they are now.
+    pub(super) fn plan(
+        &mut self,
+        physics: &PhysicsWorld,
+        time: f64,
+        (world, walls): (&World, &[WallShape]),
+        others: Vec<Disc>,
+    ) -> Plan {
+        let (x, v) = self.read_state(physics);
+        let mut plan = Plan {
+            x,
+            v,
+            sensed_now: false,
+            others: Vec::new(),
+            rebuild: false,
+        };
+        if self.frozen {
+            return plan;
+        }
+        plan.sensed_now = match &mut self.sensor {
+            Some(sensor) if sensor.due(time) => {
+                self.offsets = sensor.read(walls.len());
+                true
+            }
+            _ => false,
+        };
+        let replan_hz = world.field.replan_hz;
+        let replan_due =
+            !others.is_empty() && replan_hz > 0.0 && time + 1e-9 >= self.replans as f64 / replan_hz;
+        if replan_due {
+            self.replans += 1;
+        }
+        plan.others = others;
+        plan.rebuild = plan.sensed_now || replan_due;
+        plan
+    }
+
+    /// Step 2: the harmonic field re-solved for `plan`, if it is due (warm-started from the
+    /// last one); `None` when nothing is re-solved. Reads only this agent, so agents run it in
+    /// parallel.
+    pub(super) fn resolve(
+        &self,
+        plan: &Plan,
+        world: &World,
+    ) -> Option<Result<HarmonicField, FieldError>> {
+        match &self.field {
+            GuidanceField::Harmonic(field) if plan.rebuild => Some(HarmonicField::solve_among(
+                world,
+                &self.agent,
+                plan.x.into(),
+                &self.offsets,
+                &plan.others,
+                Some(field),
+            )),
+            _ => None,
+        }
+    }
+
+    /// Step 3: installs the field `solved` for `plan`, computes the control force for a step
+    /// of `dt` (s) and applies it to the body.
+    pub(super) fn apply(
+        &mut self,
+        plan: Plan,
+        solved: Option<Result<HarmonicField, FieldError>>,
+        physics: &mut PhysicsWorld,
+        dt: f64,
+    ) {
+        if !self.frozen {
+            let (x, v) = (plan.x, plan.v);
+            self.update_field(plan, solved);
+            self.log.control = Some(self.control(x, v, dt));
+        }
+        let force = self.log.control.map_or(Vector2::zeros(), |c| c.force);
+        let body = &mut physics.bodies[self.body];
+        body.reset_forces(false);
+        body.add_force(to_rapier(force), true);
+        self.metrics.record_force(force);
+    }
+
+    /// Step 4: after Rapier's step that ended at `time` (s), reads the state back, counts
+    /// contact starts, watches for faults against `walls` and the box of `size`, and updates
+    /// the metrics.
+    pub(super) fn observe(
+        &mut self,
+        physics: &PhysicsWorld,
+        time: f64,
+        walls: &[WallShape],
+        size: [f64; 2],
+    ) -> AgentState {
+        let (position, velocity) = self.read_state(physics);
+        let p: [f64; 2] = position.into();
+        let radial_speed = self
+            .field
+            .gradient(p)
+            .and_then(|g| unit(&g))
+            .map_or(0.0, |u| -u.dot(&velocity));
+        let signed = signed_clearance(walls, position, self.agent.radius);
+        let clearance = signed.max(0.0);
+        let faults = self.faults.observe(&Observation {
+            field: &self.field,
+            position,
+            signed_clearance: signed,
+            size,
+        });
+        self.log.events.extend(faults);
+        let contact_points = self.contacts(physics, position);
+        self.metrics
+            .record_state(time, position, velocity, clearance);
+        let log = std::mem::take(&mut self.log);
+        let control = log.control;
+        AgentState {
+            position,
+            velocity,
+            force: control.map_or(Vector2::zeros(), |c| c.force),
+            distance: (position - Vector2::from(self.agent.target)).norm(),
+            radial_speed,
+            potential: self.field.potential(p),
+            clearance,
+            contact_points,
+            clamping: control.is_some_and(|c| c.clamping),
+            speed_limited: control.is_some_and(|c| c.speed_limited),
+            beta: self.controller.beta(),
+            sensed_walls: log.sensed_walls,
+            events: log.events,
+            notes: log.notes,
+        }
+    }
+
+    /// The position and velocity Rapier has for the body. A state that is not finite freezes
+    /// the body for the rest of the run (the fault is logged once) and reads as the last
+    /// finite position at rest, so nothing non-finite reaches the controller or the metrics.
+    fn read_state(&mut self, physics: &PhysicsWorld) -> (Vector2<f64>, Vector2<f64>) {
+        let body = &physics.bodies[self.body];
+        let (x, v) = (from_rapier(body.translation()), from_rapier(body.linvel()));
+        if x.iter().chain(v.iter()).all(|c| c.is_finite()) {
+            return (x, v);
+        }
+        if !self.frozen {
+            self.frozen = true;
+            self.log.events.extend(self.faults.non_finite_state());
+        }
+        (self.last_position(), Vector2::zeros())
+    }
+
+    /// The last position recorded (the start before the first step).
+    fn last_position(&self) -> Vector2<f64> {
+        Vector2::from(*self.metrics.path().last().expect("starts at the start"))
+    }
+
+    /// Installs the re-solved harmonic field (keeping the last one, with a note, when the
+    /// rebuild failed), or gives an attractive-repulsive field the new reading and the others.
+    fn update_field(&mut self, plan: Plan, solved: Option<Result<HarmonicField, FieldError>>) {
+        match (&mut self.field, solved) {
+            (GuidanceField::Harmonic(field), Some(Ok(new))) => {
+                *field = new;
+                self.rebuild_failed = false;
+                if plan.sensed_now {
+                    self.log.sensed_walls = Some(boundary(field));
+                }
+            }
+            (GuidanceField::Harmonic(_), Some(Err(e))) => {
+                if !self.rebuild_failed {
+                    self.log.notes.push(format!(
+                        "the sensed walls and the other agents give no usable field ({e}); keeping the last one"
+                    ));
+                }
+                self.rebuild_failed = true;
+            }
+            (GuidanceField::AttractiveRepulsive(field), _) => {
+                if plan.sensed_now {
+                    field.sense(&self.offsets);
+                }
+                field.set_others(plan.others);
+            }
+            (GuidanceField::Harmonic(_), None) => {}
+        }
+    }
+
+    /// The control force at position `x` and velocity `v`, from the current field.
+    fn control(&mut self, x: Vector2<f64>, v: Vector2<f64>, dt: f64) -> ControlOutput<2> {
+        let input = ControlInput {
+            offset: x - Vector2::from(self.agent.target),
+            velocity: v,
+            gradient: self.field.gradient(x.into()),
+            dt,
+        };
+        let mut out = self.controller.step(&input);
+        // Finite in f64 but beyond f32's range is still not finite for Rapier.
+        if !to_rapier(out.force).is_finite() {
+            out.force = Vector2::zeros();
+            self.log.events.extend(self.faults.rejected_force());
+        }
+        if out.bias_updated
+            && let Some(beta) = self.controller.beta()
+        {
+            self.log.notes.push(format!(
+                "settling instant at distance {:.4} m: β ← u = [{:.4}, {:.4}] N (update {})",
+                input.offset.norm(),
+                beta.x,
+                beta.y,
+                self.controller.bias.as_ref().map_or(0, |b| b.updates())
+            ));
+        }
+        out
+    }
+
+    /// Counts the contacts that started in the last step and returns where the body touches
+    /// something now.
+    fn contacts(&mut self, physics: &PhysicsWorld, position: Vector2<f64>) -> Vec<Vector2<f64>> {
+        let mut now = HashSet::new();
+        let mut points = Vec::new();
+        for pair in physics.narrow_phase.contact_pairs_with(self.collider) {
+            if !pair.has_any_active_contact() {
+                continue;
+            }
+            let (other, side) = if pair.collider1 == self.collider {
+                (pair.collider2, 1.0)
+            } else {
+                (pair.collider1, -1.0)
+            };
+            for manifold in pair.manifolds() {
+                if manifold
+                    .points
+                    .iter()
+                    .any(|c| f64::from(c.dist) <= CONTACT_TOLERANCE)
+                {
+                    // The normal points from collider 1 to collider 2.
+                    let n = from_rapier(manifold.data.normal);
+                    points.push(position + n * (side * self.agent.radius));
+                    now.insert(other);
+                }
+            }
+        }
+        let started = now.difference(&self.touching).count();
+        self.touching = now;
+        self.metrics.record_contacts(started);
+        points
+    }
+}
+
+/// The centres of the blocked cells of `field`'s mask that have a free 4-neighbour: the outline
+/// of the configuration-space obstacles the field was solved for.
+fn boundary(field: &HarmonicField) -> Vec<[f64; 2]> {
+    let grid = field.grid();
+    let blocked = &field.blocked;
+    let mut points = Vec::new();
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            if !blocked[grid.index(i, j)] {
+                continue;
+            }
+            let free = |a: usize, b: usize| !blocked[grid.index(a, b)];
+            if (i > 0 && free(i - 1, j))
+                || (i + 1 < grid.nx && free(i + 1, j))
+                || (j > 0 && free(i, j - 1))
+                || (j + 1 < grid.ny && free(i, j + 1))
+            {
+                points.push(grid.center(i, j));
+            }
+        }
+    }
+    points
+}
