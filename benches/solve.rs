@@ -78,7 +78,8 @@ fn solves(c: &mut Criterion) {
         1e-10,
         None,
     )
-    .w;
+    .w
+    .to_plain();
     let after = room(512, &[format!("walls.1.center.0={}", 6.75 + 10.0 / 512.0)]);
     for (name, warm) in [("cold", None), ("warm", Some(old.as_slice()))] {
         group.bench_function(name, |b| {

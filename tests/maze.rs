@@ -37,3 +37,36 @@ fn the_maze_is_flat_in_f64_v_yet_every_sampled_streamline_reaches_the_target() {
     }
     assert!(checked > 300, "only {checked} cells sampled");
 }
+
+/// The nested levels compose one field: at every reachable cell but the target, `W` is the
+/// average of its four neighbours to a relative 1e-5, at whatever depth, across the seams
+/// between the levels' bands.
+#[test]
+fn the_maze_field_is_harmonic_at_every_cell_across_the_levels() {
+    let world = common::world("maze.toml", &[]);
+    let agent = &world.agents[0];
+    let field = HarmonicField::solve(&world, agent).unwrap();
+    let grid = *field.grid();
+    let w = field.sampler.values();
+    let reachable = field.sampler.reachable_cells();
+    let (ti, tj) = grid.cell_of(agent.target).unwrap();
+    let mut worst: f64 = 0.0;
+    let mut deepest = f64::INFINITY;
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            let k = grid.index(i, j);
+            if !reachable[k] || (i, j) == (ti, tj) {
+                continue;
+            }
+            let e = w.exponent[k];
+            let sum: f64 = grid
+                .neighbours(i, j)
+                .map(|(a, b)| w.at_scale(grid.index(a, b), e))
+                .sum();
+            worst = worst.max((4.0 * w.mantissa[k] - sum).abs() / (4.0 * w.mantissa[k]));
+            deepest = deepest.min(w.log10(k));
+        }
+    }
+    assert!(worst < 1e-5, "largest relative residual {worst:e}");
+    assert!(deepest < -130.0, "deepest log10 W {deepest}");
+}

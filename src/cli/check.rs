@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use super::{Failure, load};
 use crate::field::FreeSpace;
+use crate::sim::Simulation;
 
 /// The arguments of `nadf check`.
 #[derive(Debug, Clone, clap::Args)]
@@ -13,8 +14,9 @@ pub struct CheckArgs {
     pub worlds: Vec<PathBuf>,
 }
 
-/// Checks every file: its problems, each with its file, line and key, its warnings, and
-/// whether every agent's task is tractable on its grid. Fails when any file has a problem.
+/// Checks every file: its problems, each with its file, line and key, its warnings, whether
+/// every agent's task is tractable on its grid, and (solving the fields) whether the field
+/// guides every agent from its start. Fails when any file has a problem.
 pub fn check(args: &CheckArgs) -> Result<(), Failure> {
     let mut problems = Vec::new();
     for path in &args.worlds {
@@ -25,7 +27,12 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
                 continue;
             }
         };
-        let intractable = FreeSpace::intractable(&world);
+        let mut intractable = FreeSpace::intractable(&world);
+        if intractable.is_empty()
+            && let Err(e) = Simulation::new(&world)
+        {
+            intractable.push(e);
+        }
         if intractable.is_empty() {
             println!(
                 "{}: ok ({}, {} agent(s), {} wall(s))",

@@ -80,13 +80,14 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         field.relative_residual
     );
     println!(
-        "1 - V at the start: {:.3e}",
-        field.one_minus_potential(agent.start)
+        "1 - V at the start: {}",
+        scientific(field.log10_one_minus_potential(agent.start))
     );
     let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-    if let Some([v, w, mask]) = npy {
+    if let Some([v, w, log, mask]) = npy {
         files.push((v, export::potential_npy(&field)));
         files.push((w, export::one_minus_potential_npy(&field)));
+        files.push((log, export::log10_one_minus_potential_npy(&field)));
         files.push((mask, export::mask_npy(&field)));
     }
     if let Some(png) = &args.png {
@@ -98,4 +99,31 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         println!("wrote {}", out.display());
     }
     Ok(())
+}
+
+/// `10^x` in scientific notation, for any `x` (`3.162e-7000`).
+fn scientific(log10: f64) -> String {
+    if !log10.is_finite() {
+        return "0".into();
+    }
+    let exponent = log10.floor();
+    let mantissa = 10f64.powf(log10 - exponent);
+    // 9.9996 rounds to 10.000: carry into the exponent.
+    let (mantissa, exponent) = if format!("{mantissa:.3}").starts_with("10") {
+        (1.0, exponent + 1.0)
+    } else {
+        (mantissa, exponent)
+    };
+    format!("{mantissa:.3}e{exponent}")
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn scientific_notation_reaches_below_f64() {
+        assert_eq!(super::scientific(-7000.5), "3.162e-7001");
+        assert_eq!(super::scientific(0.0), "1.000e0");
+        assert_eq!(super::scientific(-5.00001), "1.000e-5");
+        assert_eq!(super::scientific(f64::NEG_INFINITY), "0");
+    }
 }

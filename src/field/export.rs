@@ -42,16 +42,28 @@ fn npy(grid: &Grid, descr: &str, element_bytes: usize, data: impl Fn(usize) -> V
 
 /// `V = 1 − W` per cell as little-endian float64 (exactly 1 where `W` is below 1e-16).
 pub fn potential_npy(field: &HarmonicField) -> Vec<u8> {
-    let w = field.sampler.w_cells();
+    let w = field.sampler.values();
     npy(field.grid(), "<f8", 8, |k| {
-        (1.0 - w[k]).to_le_bytes().to_vec()
+        (1.0 - w.value(k)).to_le_bytes().to_vec()
     })
 }
 
-/// `W = 1 − V` per cell as little-endian float64, with full relative precision.
+/// `W = 1 − V` per cell as little-endian float64, with full relative precision down to f64's
+/// range (0 below 1e-308: see [`log10_one_minus_potential_npy`]).
 pub fn one_minus_potential_npy(field: &HarmonicField) -> Vec<u8> {
-    let w = field.sampler.w_cells();
-    npy(field.grid(), "<f8", 8, |k| w[k].to_le_bytes().to_vec())
+    let w = field.sampler.values();
+    npy(field.grid(), "<f8", 8, |k| {
+        w.value(k).to_le_bytes().to_vec()
+    })
+}
+
+/// `log10 W` per cell as little-endian float64, at any depth (−inf on blocked and unreachable
+/// cells).
+pub fn log10_one_minus_potential_npy(field: &HarmonicField) -> Vec<u8> {
+    let w = field.sampler.values();
+    npy(field.grid(), "<f8", 8, |k| {
+        w.log10(k).to_le_bytes().to_vec()
+    })
 }
 
 /// The mask as uint8: one [`CellClass`] per cell.
@@ -69,16 +81,21 @@ pub fn mask_npy(field: &HarmonicField) -> Vec<u8> {
     })
 }
 
-/// The paths of the three arrays `--npy FILE` writes: `FILE` (V), `FILE.w.npy` and
-/// `FILE.mask.npy` with `FILE`'s `.npy` extension replaced.
-pub fn npy_paths(path: &std::path::Path) -> [std::path::PathBuf; 3] {
+/// The paths of the four arrays `--npy FILE` writes: `FILE` (V), `FILE.w.npy`,
+/// `FILE.log10w.npy` and `FILE.mask.npy` with `FILE`'s `.npy` extension replaced.
+pub fn npy_paths(path: &std::path::Path) -> [std::path::PathBuf; 4] {
     let stem = path.with_extension("");
     let with = |suffix: &str| {
         let mut s = stem.as_os_str().to_owned();
         s.push(suffix);
         std::path::PathBuf::from(s)
     };
-    [path.to_path_buf(), with(".w.npy"), with(".mask.npy")]
+    [
+        path.to_path_buf(),
+        with(".w.npy"),
+        with(".log10w.npy"),
+        with(".mask.npy"),
+    ]
 }
 
 /// Encodes RGB bytes (`width × height`, top row first) as a PNG.
@@ -116,9 +133,10 @@ mod tests {
 
     #[test]
     fn npy_paths_put_the_extra_arrays_beside_the_first() {
-        let [v, w, m] = npy_paths(std::path::Path::new("out/field.npy"));
+        let [v, w, log, m] = npy_paths(std::path::Path::new("out/field.npy"));
         assert_eq!(v, std::path::Path::new("out/field.npy"));
         assert_eq!(w, std::path::Path::new("out/field.w.npy"));
+        assert_eq!(log, std::path::Path::new("out/field.log10w.npy"));
         assert_eq!(m, std::path::Path::new("out/field.mask.npy"));
     }
 

@@ -1,18 +1,14 @@
-//! An agent's harmonic field ([`HarmonicField`]) and its production solve of `W = 1 − V`:
-//! multigrid-preconditioned CG (`multigrid/`), then nested, rescaled re-solves of the regions
-//! where `W` is tiny.
+//! An agent's harmonic field ([`HarmonicField`]) and its production solve of `W = 1 − V`
+//! ([`solve_w`]): multigrid-preconditioned CG (`multigrid/`) over the whole grid, then the
+//! nested levels below what that resolves (`nested.rs`).
 //!
 //! A solve to a relative residual of 1e-10 gives `W` to about 1e-12 absolute. Behind a few
 //! turns `W` is far smaller than that (1e-13 in the 10 m room at 1 cm cells, 1e-17 in a
-//! 16 m × 10 m world with three shelves, 1e-140 in the maze), so the first solution there is
-//! noise, and the guidance direction with it. The deep region `D`, the cells below τ = 1e-6
-//! (less those next to a wall, see [`deep_cells`]), is therefore solved again: each connected
-//! part of it on its own, on its bounding box. Its boundary values — the neighbouring cells,
-//! where `W` is known to full relative precision — are divided by τ, the problem is solved on
-//! the part alone, and the result multiplied by τ. By the maximum principle a relative error ε
-//! in the boundary values is at most ε relative everywhere inside, so each level keeps relative
-//! precision and reaches six orders of magnitude deeper. This repeats until no cell is below the
-//! current depth: the field never goes flat where a path exists.
+//! 16 m × 10 m world with three shelves, 1e-140 in the spiral maze, 1e-6500 in a benchmark
+//! maze), so the first solution there is noise, and the guidance direction with it. The cells
+//! below τ = 1e-6 (less those next to a wall, see `deep_cells`) are therefore solved again,
+//! band after band, each at its own scale and stored with its exponent ([`ScaledW`]): the
+//! field never goes flat where a path exists, however deep.
 
 use std::time::{Duration, Instant};
 
@@ -21,8 +17,16 @@ use nalgebra::Vector2;
 use super::grid::Grid;
 use super::mask::CellCounts;
 use super::multigrid;
+use super::nested::{DEPTH_STEP, LevelStats, MAX_ITERATIONS, deep_cells, solve_levels};
+use super::scaled::{ScaledW, ldexp};
 use super::{Disc, FieldError, FreeSpace, Sampler, Streamline};
+use crate::control::unit;
 use crate::world::{Agent, World};
+
+/// The smallest `|∇V|` [`HarmonicField::gradient`] returns, 1/m: a gradient below it is
+/// returned at this magnitude with its direction (above `control::MIN_GRADIENT`, far below
+/// anything a force in f32 can carry).
+pub const GRADIENT_FLOOR: f64 = 1e-270;
 
 /// The solved field of one agent, with the statistics of the solve.
 #[derive(Debug, Clone)]
@@ -64,8 +68,8 @@ impl HarmonicField {
     ) -> Result<Self, FieldError> {
         let started = Instant::now();
         let space = FreeSpace::among(world, agent, position, offsets, others)?;
-        let warm = previous.map(|f| f.sampler.w_cells());
-        Self::solve_space(world, agent, space, warm, started)
+        let warm = previous.map(|f| f.sampler.values().to_plain());
+        Self::solve_space(world, agent, space, warm.as_deref(), started)
     }
 
     fn solve_space(
@@ -116,15 +120,50 @@ impl HarmonicField {
         1.0 - self.sampler.w(p).unwrap_or(0.0)
     }
 
-    /// `1 - V` at `p`, with full relative precision where `V` is close to 1.
+    /// `1 - V` at `p`, with full relative precision where `V` is close to 1 (0 where it is
+    /// below f64's range: see [`HarmonicField::log10_one_minus_potential`]).
     pub fn one_minus_potential(&self, p: [f64; 2]) -> f64 {
         self.sampler.w(p).unwrap_or(0.0)
     }
 
+    /// `log10(1 − V)` at `p`, at any depth (−∞ where nothing reachable is near).
+    pub fn log10_one_minus_potential(&self, p: [f64; 2]) -> f64 {
+        match self.sampler.w_scaled(p) {
+            Some((w, e)) if w > 0.0 => (w.log2() + f64::from(e)) * std::f64::consts::LOG10_2,
+            _ => f64::NEG_INFINITY,
+        }
+    }
+
     /// The gradient `g = ∇V` at `p`; `None` where the field is undefined (far from any
     /// reachable cell). Callers treat `None` like a vanishing gradient.
+    ///
+    /// Deep in a maze `|∇V|` is far below f64's range (1e-6500 and less). There the gradient
+    /// is returned at magnitude [`GRADIENT_FLOOR`] with its exact direction: the paper's
+    /// `−K∇V` is still nothing (no force that small survives the conversion to Rapier's f32),
+    /// while normalized guidance and NADF's split, which use the direction only, keep it.
     pub fn gradient(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
-        self.sampler.grad_w(p).map(|g| -g)
+        let (g, e) = self.sampler.grad_w_scaled(p)?;
+        let true_size = g.map(|c| ldexp(c, e));
+        let size = g.norm();
+        if true_size.norm() >= GRADIENT_FLOOR || !(size > 0.0 && size.is_finite()) {
+            return Some(-true_size);
+        }
+        Some(-g * (GRADIENT_FLOOR / size))
+    }
+
+    /// Checks that the field gives `agent` a direction at its start (or that it starts on its
+    /// target): with no direction there, a run could only stand still.
+    pub fn check_start(&self, agent: &Agent) -> Result<(), FieldError> {
+        let [sx, sy] = agent.start;
+        let at_target = (sx - self.target[0]).hypot(sy - self.target[1]) <= self.grid().cell;
+        if at_target || self.gradient(agent.start).and_then(|g| unit(&g)).is_some() {
+            Ok(())
+        } else {
+            Err(FieldError::NoGuidance {
+                agent: agent.name.clone(),
+                start: agent.start,
+            })
+        }
     }
 
     /// The kinematic path from `start` (eq. 4, normalized).
@@ -139,30 +178,25 @@ impl HarmonicField {
     }
 }
 
-/// The depth gained by each nested solve.
-pub const DEPTH_STEP: f64 = 1e-6;
-/// How many steps through free cells a cell below the depth may be from a cell above it and
-/// still count as resolved (see [`deep_cells`]).
-pub const REACH: usize = 8;
-/// CG iterations allowed per solve.
-pub const MAX_ITERATIONS: usize = 500;
-
 /// The solved field and how the solve went.
 #[derive(Debug, Clone)]
 pub struct HarmonicSolution {
-    /// `W` per cell: 1 at the target, 0 on blocked and unreachable cells.
-    pub w: Vec<f64>,
+    /// `W` per cell: 1 at the target, 0 on blocked and unreachable cells, at any depth.
+    pub w: ScaledW,
     /// CG iterations over all solves.
     pub iterations: usize,
     /// Solves: the first one plus the nested ones.
     pub solves: usize,
     /// The worst final relative residual of the solves.
     pub relative_residual: f64,
+    /// The nested levels (see `nested.rs`).
+    pub nested: LevelStats,
 }
 
 /// Solves for `W` on the `reachable` cells with `W = 1` at `target`, each solve to a relative
-/// residual of `tolerance`. `warm` is a previous `W` on the same grid to start from (after a
-/// small change of the world), if any.
+/// residual of `tolerance`: the first solve over the whole grid, then the nested levels below
+/// what it resolves. `warm` is a previous `W` on the same grid to start the first solve from
+/// (after a small change of the world), if any.
 pub fn solve_w(
     grid: &Grid,
     reachable: &[bool],
@@ -183,151 +217,49 @@ pub fn solve_w(
     };
     w[t] = 1.0;
     let first = multigrid::solve(grid, &unknown, &mut w, tolerance, MAX_ITERATIONS);
-    let mut out = HarmonicSolution {
-        w: Vec::new(),
-        iterations: first.iterations,
-        solves: 1,
-        relative_residual: first.relative_residual,
-    };
-    let mut depth = DEPTH_STEP;
-    while depth > 1e-290 {
-        let deep = deep_cells(grid, &unknown, &w, depth);
-        let regions = regions(grid, &deep);
-        if regions.is_empty() {
-            break;
-        }
-        for cells in &regions {
-            let stats = solve_deep(grid, cells, &mut w, depth, tolerance);
-            out.iterations += stats.iterations;
-            out.solves += 1;
-            out.relative_residual = out.relative_residual.max(stats.relative_residual);
-        }
-        depth *= DEPTH_STEP;
+    let pending = deep_cells(grid, &unknown, &w, DEPTH_STEP);
+    let mut w = ScaledW::from_plain(w);
+    let nested = solve_levels(grid, pending, &mut w, tolerance);
+    HarmonicSolution {
+        w,
+        iterations: first.iterations + nested.iterations,
+        solves: 1 + nested.solves,
+        relative_residual: first.relative_residual.max(nested.relative_residual),
+        nested,
     }
-    out.w = w;
-    out
-}
-
-/// The cells below `depth` that need a nested solve: those more than [`REACH`] steps through
-/// free cells from any cell at or above it.
-///
-/// A cell next to a wall has a small `W` however close it is to the target, because `W = 0` on
-/// the wall; but so has the solve's error, which is harmonic with the same zero there, so such a
-/// cell is known to the relative precision of the cells a few steps away from the wall.
-/// Counting them as deep would make the nested solves cover every wall of the world. The
-/// distance is counted through free cells: across a wall, a cell's neighbourhood says nothing
-/// about it. (In a corridor one cell wide, the narrowest there is, `W` falls by 2 − √3 per
-/// cell, so `REACH` steps lose at most a factor 3e-5 of relative precision.)
-pub fn deep_cells(grid: &Grid, unknown: &[bool], w: &[f64], depth: f64) -> Vec<bool> {
-    let below = |k: usize| unknown[k] && w[k] < depth;
-    let mut deep: Vec<bool> = (0..grid.len()).map(below).collect();
-    // Breadth-first from the cells below the depth that touch one above it.
-    let mut front = Vec::new();
-    for j in 0..grid.ny {
-        for i in 0..grid.nx {
-            let k = grid.index(i, j);
-            if deep[k]
-                && grid
-                    .neighbours(i, j)
-                    .any(|(a, b)| unknown[grid.index(a, b)] && !below(grid.index(a, b)))
-            {
-                front.push((i, j));
-            }
-        }
-    }
-    for &(i, j) in &front {
-        deep[grid.index(i, j)] = false;
-    }
-    for _ in 1..REACH {
-        let mut next = Vec::new();
-        for &(i, j) in &front {
-            for (a, b) in grid.neighbours(i, j) {
-                let k = grid.index(a, b);
-                if deep[k] {
-                    deep[k] = false;
-                    next.push((a, b));
-                }
-            }
-        }
-        front = next;
-    }
-    deep
-}
-
-/// The connected regions (4-neighbours) of the `deep` cells, each as a list of cell indices.
-fn regions(grid: &Grid, deep: &[bool]) -> Vec<Vec<usize>> {
-    let mut seen = vec![false; grid.len()];
-    let mut regions = Vec::new();
-    for start in 0..grid.len() {
-        if !deep[start] || seen[start] {
-            continue;
-        }
-        seen[start] = true;
-        let mut cells = vec![start];
-        let mut next = 0;
-        while next < cells.len() {
-            let k = cells[next];
-            next += 1;
-            for (a, b) in grid.neighbours(k % grid.nx, k / grid.nx) {
-                let m = grid.index(a, b);
-                if deep[m] && !seen[m] {
-                    seen[m] = true;
-                    cells.push(m);
-                }
-            }
-        }
-        regions.push(cells);
-    }
-    regions
-}
-
-/// Re-solves `W` on one connected region of deep cells, scaled by `1/depth`, with the cells
-/// around it as Dirichlet values. Works on the region's bounding box plus a one-cell margin
-/// (which holds their fixed neighbours), so small regions and deeper levels cost little. Other
-/// regions inside the box are not its neighbours, so their values do not matter.
-fn solve_deep(
-    grid: &Grid,
-    cells: &[usize],
-    w: &mut [f64],
-    depth: f64,
-    tolerance: f64,
-) -> multigrid::Stats {
-    let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
-    for &k in cells {
-        let (i, j) = (k % grid.nx, k / grid.nx);
-        lo = [lo[0].min(i), lo[1].min(j)];
-        hi = [hi[0].max(i), hi[1].max(j)];
-    }
-    let (i0, j0) = (lo[0].saturating_sub(1), lo[1].saturating_sub(1));
-    let (i1, j1) = ((hi[0] + 1).min(grid.nx - 1), (hi[1] + 1).min(grid.ny - 1));
-    let sub = Grid {
-        nx: i1 - i0 + 1,
-        ny: j1 - j0 + 1,
-        cell: grid.cell,
-        origin: grid.center(i0, j0).map(|c| c - 0.5 * grid.cell),
-    };
-    let mut unknown = vec![false; sub.len()];
-    for &k in cells {
-        unknown[sub.index(k % grid.nx - i0, k / grid.nx - j0)] = true;
-    }
-    let mut scaled = vec![0.0; sub.len()];
-    for j in 0..sub.ny {
-        let row = grid.index(i0, j0 + j);
-        for (i, v) in scaled[j * sub.nx..(j + 1) * sub.nx].iter_mut().enumerate() {
-            *v = w[row + i].max(0.0) / depth;
-        }
-    }
-    let stats = multigrid::solve(&sub, &unknown, &mut scaled, tolerance, MAX_ITERATIONS);
-    for &k in cells {
-        w[k] = scaled[sub.index(k % grid.nx - i0, k / grid.nx - j0)] * depth;
-    }
-    stats
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::field::laplace::reachable_from;
+    use crate::field::nested::REACH;
+
+    /// A field flat around the start gives it no direction: an error, not a run that stands
+    /// still.
+    #[test]
+    fn a_start_without_direction_is_an_error() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/room-two-dividers.toml");
+        let world = crate::world::load(&path, &["field.cell=0.1".parse().unwrap()]).unwrap();
+        let agent = &world.agents[0];
+        let mut field = HarmonicField::solve(&world, agent).unwrap();
+        assert_eq!(field.check_start(agent), Ok(()));
+        // The same cells, with W constant: no gradient anywhere inside.
+        let grid = *field.grid();
+        let reachable = field.sampler.reachable_cells().to_vec();
+        let flat = ScaledW::from_plain(reachable.iter().map(|r| f64::from(u8::from(*r))).collect());
+        field.sampler = Sampler::new(grid, flat, reachable);
+        let error = field.check_start(agent).unwrap_err();
+        assert!(
+            error.to_string().contains("no direction at its start"),
+            "{error}"
+        );
+        // On its target, an agent needs none.
+        let mut there = agent.clone();
+        there.start = there.target;
+        assert_eq!(field.check_start(&there), Ok(()));
+    }
 
     /// Cells below the depth next to a shallow cell are resolved (a wall's neighbours), cells
     /// more than `REACH` steps in are deep, and reach does not cross a wall.
@@ -343,11 +275,6 @@ mod tests {
         for (i, deep) in deep.iter().enumerate() {
             assert_eq!(*deep, i >= 5 + REACH && i != 20, "cell {i}");
         }
-        // Two separate regions: either side of the wall.
-        let regions = regions(&grid, &deep);
-        assert_eq!(regions.len(), 2);
-        assert_eq!(regions[0], (5 + REACH..20).collect::<Vec<_>>());
-        assert_eq!(regions[1], (21..30).collect::<Vec<_>>());
     }
 
     /// A long corridor: `W` decays by about e^(−π) per corridor width, to far below what one
@@ -360,7 +287,7 @@ mod tests {
         let reachable = reachable_from(&grid, &blocked, target);
         let s = solve_w(&grid, &reachable, target, 1e-12, None);
         assert!(s.solves > 3, "{} solves", s.solves);
-        let row: Vec<f64> = (0..grid.nx).map(|i| s.w[grid.index(i, 5)]).collect();
+        let row: Vec<f64> = (0..grid.nx).map(|i| s.w.value(grid.index(i, 5))).collect();
         assert!(
             row[grid.nx - 1] > 0.0 && row[grid.nx - 1] < 1e-25,
             "{:e}",

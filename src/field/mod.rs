@@ -29,23 +29,27 @@ mod harmonic;
 mod laplace;
 mod mask;
 mod multigrid;
+mod nested;
 mod sample;
+mod scaled;
 mod streamline;
 
 pub use firas::AttractiveRepulsive;
 pub use grid::Grid;
 pub use guidance_field::GuidanceField;
-pub use harmonic::HarmonicField;
+pub use harmonic::{GRADIENT_FLOOR, HarmonicField};
 pub use mask::{CellCounts, Disc, FreeSpace};
 pub use sample::Sampler;
+pub use scaled::ScaledW;
 pub use streamline::Streamline;
 
 /// The solver's internals, public for the benchmarks only: not part of the crate's API.
 #[doc(hidden)]
 pub mod solvers {
-    pub use super::harmonic::{MAX_ITERATIONS, solve_w};
+    pub use super::harmonic::solve_w;
     pub use super::laplace::solve_sor;
     pub use super::multigrid::{set_portable, solve};
+    pub use super::nested::MAX_ITERATIONS;
 }
 
 /// Why a field could not be built for an agent.
@@ -70,6 +74,17 @@ pub enum FieldError {
         agent: String,
         /// The agent's radius, m.
         radius: f64,
+    },
+    /// The field gives no direction at the agent's start.
+    #[error(
+        "agent `{agent}`: the field gives no direction at its start [{}, {}] (a critical point of the field, or off it): it cannot be guided from there; move the start",
+        start[0], start[1]
+    )]
+    NoGuidance {
+        /// The agent's name.
+        agent: String,
+        /// Its start, m.
+        start: [f64; 2],
     },
     /// The solver did not reach the tolerance.
     #[error(

@@ -1,9 +1,12 @@
 //! Sampling the solved field between cell centres: `W` and `∇W` by bilinear interpolation over
-//! the reachable cells, `∇W` at a centre by central differences.
+//! the reachable cells, `∇W` at a centre by central differences. Values are [`ScaledW`]: each
+//! sample is taken at the largest scale of the cells it reads, so it keeps its relative
+//! precision however deep the field goes (see `scaled.rs`).
 
 use nalgebra::Vector2;
 
 use super::grid::Grid;
+use super::scaled::{ScaledW, ldexp};
 
 /// Up to four cells and their interpolation weights, without allocating (sampling runs
 /// several times per agent and step).
@@ -28,27 +31,29 @@ impl Stencil {
 #[derive(Debug, Clone)]
 pub struct Sampler {
     grid: Grid,
-    w: Vec<f64>,
+    w: ScaledW,
+    /// `∇W` at each cell centre, at that cell's scale `2^exponent`.
     grad_w: Vec<Vector2<f64>>,
     reachable: Vec<bool>,
 }
 
 impl Sampler {
     /// Precomputes central differences of `w` (blocked and off-grid neighbours count as the
-    /// boundary value 0).
-    pub fn new(grid: Grid, w: Vec<f64>, reachable: Vec<bool>) -> Self {
-        let at = |i: isize, j: isize| {
-            if i < 0 || j < 0 || i >= grid.nx as isize || j >= grid.ny as isize {
-                0.0
-            } else {
-                w[grid.index(i as usize, j as usize)]
-            }
-        };
+    /// boundary value 0), each at its cell's scale.
+    pub fn new(grid: Grid, w: ScaledW, reachable: Vec<bool>) -> Self {
         let mut grad_w = vec![Vector2::zeros(); grid.len()];
         for j in 0..grid.ny {
             for i in 0..grid.nx {
                 let k = grid.index(i, j);
                 if reachable[k] {
+                    let e = w.exponent[k];
+                    let at = |i: isize, j: isize| {
+                        if i < 0 || j < 0 || i >= grid.nx as isize || j >= grid.ny as isize {
+                            0.0
+                        } else {
+                            w.at_scale(grid.index(i as usize, j as usize), e)
+                        }
+                    };
                     let (i, j) = (i as isize, j as isize);
                     grad_w[k] =
                         Vector2::new(at(i + 1, j) - at(i - 1, j), at(i, j + 1) - at(i, j - 1))
@@ -107,22 +112,49 @@ impl Sampler {
         out
     }
 
-    /// `W = 1 - V` at `p`, if `p` is next to a reachable cell.
-    pub fn w(&self, p: [f64; 2]) -> Option<f64> {
-        let s = self.stencil(p);
-        let s = s.cells();
-        (!s.is_empty()).then(|| s.iter().map(|&(k, a)| a * self.w[k]).sum())
+    /// The largest exponent among the stencil's cells: the scale a sample is taken at.
+    fn scale(&self, s: &[(usize, f64)]) -> i32 {
+        s.iter()
+            .map(|&(k, _)| self.w.exponent[k])
+            .max()
+            .unwrap_or(0)
     }
 
-    /// `∇W = -∇V` at `p`, if `p` is next to a reachable cell.
-    pub fn grad_w(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
+    /// `W = 1 - V` at `p` as `(w, e)` with `W = w · 2^e`, if `p` is next to a reachable cell.
+    pub fn w_scaled(&self, p: [f64; 2]) -> Option<(f64, i32)> {
         let s = self.stencil(p);
         let s = s.cells();
-        (!s.is_empty()).then(|| s.iter().map(|&(k, a)| self.grad_w[k] * a).sum())
+        let e = self.scale(s);
+        (!s.is_empty()).then(|| (s.iter().map(|&(k, a)| a * self.w.at_scale(k, e)).sum(), e))
+    }
+
+    /// `W = 1 - V` at `p` (0 where it is below f64's range), if `p` is next to a reachable
+    /// cell.
+    pub fn w(&self, p: [f64; 2]) -> Option<f64> {
+        self.w_scaled(p).map(|(w, e)| ldexp(w, e))
+    }
+
+    /// `∇W = -∇V` at `p` as `(g, e)` with `∇W = g · 2^e`, if `p` is next to a reachable cell:
+    /// its direction at full precision however small it is.
+    pub fn grad_w_scaled(&self, p: [f64; 2]) -> Option<(Vector2<f64>, i32)> {
+        let s = self.stencil(p);
+        let s = s.cells();
+        let e = self.scale(s);
+        let at_scale = |k: usize| match self.w.exponent[k] - e {
+            0 => self.grad_w[k],
+            shift => self.grad_w[k].map(|c| ldexp(c, shift)),
+        };
+        (!s.is_empty()).then(|| (s.iter().map(|&(k, a)| at_scale(k) * a).sum(), e))
+    }
+
+    /// `∇W = -∇V` at `p` (0 where it is below f64's range), if `p` is next to a reachable
+    /// cell.
+    pub fn grad_w(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
+        self.grad_w_scaled(p).map(|(g, e)| g.map(|c| ldexp(c, e)))
     }
 
     /// `W` at every cell (0 where blocked or unreachable).
-    pub fn w_cells(&self) -> &[f64] {
+    pub fn values(&self) -> &ScaledW {
         &self.w
     }
 
@@ -152,7 +184,7 @@ mod tests {
                 w[grid.index(i, j)] = 0.1 + 0.3 * x - 0.2 * y;
             }
         }
-        let s = Sampler::new(grid, w, vec![true; grid.len()]);
+        let s = Sampler::new(grid, ScaledW::from_plain(w), vec![true; grid.len()]);
         let p = [0.93, 0.41];
         assert!((s.w(p).unwrap() - (0.1 + 0.3 * 0.93 - 0.2 * 0.41)).abs() < 1e-12);
         let g = s.grad_w(p).unwrap();
@@ -171,9 +203,40 @@ mod tests {
                 reachable[grid.index(i, j)] = false;
             }
         }
-        let s = Sampler::new(grid, vec![0.5; grid.len()], reachable);
+        let s = Sampler::new(grid, ScaledW::from_plain(vec![0.5; grid.len()]), reachable);
         assert!(s.w([0.15, 0.15]).is_none());
         assert!(s.grad_w([f64::NAN, 0.5]).is_none());
         assert!(s.w([0.8, 0.8]).is_some());
+    }
+}
+
+#[cfg(test)]
+mod deep {
+    use super::*;
+
+    /// A linear `W` scaled far below f64's range is sampled with the same direction and the
+    /// same value at its scale as at the scale of 1.
+    #[test]
+    fn fields_below_f64_keep_their_direction() {
+        let grid = Grid::covering([2.0, 1.0], 0.1);
+        let mut w = vec![0.0; grid.len()];
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                let [x, y] = grid.center(i, j);
+                w[grid.index(i, j)] = 0.1 + 0.3 * x - 0.2 * y;
+            }
+        }
+        let plain = Sampler::new(grid, ScaledW::from_plain(w.clone()), vec![true; grid.len()]);
+        let deep = ScaledW {
+            mantissa: w,
+            exponent: vec![-5000; grid.len()],
+        };
+        let deep = Sampler::new(grid, deep, vec![true; grid.len()]);
+        let p = [0.93, 0.41];
+        let (g, e) = deep.grad_w_scaled(p).unwrap();
+        assert_eq!(e, -5000);
+        assert_eq!(g, plain.grad_w(p).unwrap());
+        assert_eq!(deep.w_scaled(p).unwrap(), (plain.w(p).unwrap(), -5000));
+        assert_eq!(deep.w(p), Some(0.0));
     }
 }

@@ -23,9 +23,9 @@ pub fn streamline(
     max_length: f64,
 ) -> Streamline {
     let cell = sampler.grid().cell;
-    // ∇W = -∇V: the direction of descent.
+    // ∇W = -∇V: the direction of descent, at the cells' scale (its size does not matter).
     integrate(
-        |p| sampler.grad_w(p),
+        |p| sampler.grad_w_scaled(p).map(|(g, _)| g),
         start,
         target,
         0.5 * cell,

@@ -7,29 +7,23 @@ use crate::field::HarmonicField;
 /// the recording's transforms put it the right way up), and the image's `[width, height]`.
 pub fn potential_image(field: &HarmonicField) -> (Vec<u8>, [u32; 2]) {
     let grid = *field.grid();
-    let w = field.sampler.w_cells();
+    let w = field.sampler.values();
     let reachable = field.sampler.reachable_cells();
-    let logs: Vec<f64> = w
-        .iter()
-        .zip(reachable)
-        .filter(|&(w, r)| *r && *w > 0.0)
-        .map(|(w, _)| w.log10())
-        .collect();
-    let lo = logs.iter().copied().fold(0.0_f64, f64::min);
+    let lo = (0..grid.len())
+        .filter(|&k| reachable[k])
+        .map(|k| w.log10(k))
+        .filter(|l| l.is_finite())
+        .fold(0.0_f64, f64::min);
     let mut rgb = Vec::with_capacity(grid.len() * 3);
     for j in 0..grid.ny {
         for i in 0..grid.nx {
             let k = grid.index(i, j);
             let colour = if field.blocked[k] {
                 BLOCKED
-            } else if !reachable[k] || w[k] <= 0.0 {
+            } else if !reachable[k] || !w.log10(k).is_finite() {
                 UNREACHABLE
             } else {
-                let t = if lo < 0.0 {
-                    1.0 - w[k].log10() / lo
-                } else {
-                    1.0
-                };
+                let t = if lo < 0.0 { 1.0 - w.log10(k) / lo } else { 1.0 };
                 viridis(t)
             };
             rgb.extend_from_slice(&colour);

@@ -72,7 +72,8 @@ impl Simulation {
     ///
     /// With several agents, each field starts with the others at their starts; if they cut an
     /// agent off from its target there, its first field ignores them (they will move), and only
-    /// a target that the walls alone make unreachable is an error.
+    /// a target that the walls alone make unreachable is an error. So is a start where the
+    /// field gives no direction ([`FieldError::NoGuidance`]).
     pub fn new(world: &World) -> Result<Self, FieldError> {
         let mut physics = physics::empty_world(world.dt, world.external_acceleration);
         let walls = all_wall_shapes(world);
@@ -94,6 +95,9 @@ impl Simulation {
                 }
                 result => result?,
             };
+            if let Some(harmonic) = field.harmonic() {
+                harmonic.check_start(agent)?;
+            }
             agents.push(AgentRun::new(world, index, field, &mut physics));
         }
         let pendulums = world

@@ -328,3 +328,43 @@ mod fast_path {
         );
     }
 }
+
+#[cfg(test)]
+mod warm {
+    use super::*;
+
+    #[test]
+    fn a_warm_start_far_from_the_solution_still_converges_to_it() {
+        let grid = Grid::covering([1.0, 3.0], 1.0 / 64.0);
+        let mut unknown = vec![false; grid.len()];
+        for j in 2..grid.ny - 2 {
+            for i in 20..30 {
+                unknown[grid.index(i, j)] = true;
+            }
+        }
+        let mut w = vec![0.0; grid.len()];
+        for i in 20..30 {
+            w[grid.index(i, 1)] = 1.0;
+        }
+        for (k, v) in w.iter_mut().enumerate() {
+            if unknown[k] {
+                *v = 0.3 + 0.2 * ((k * 7919) % 13) as f64 / 13.0;
+            }
+        }
+        let stats = solve(&grid, &unknown, &mut w, 1e-12, 100);
+        let mut worst: f64 = 0.0;
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                let k = grid.index(i, j);
+                if unknown[k] {
+                    let s: f64 = grid
+                        .neighbours(i, j)
+                        .map(|(a, b)| w[grid.index(a, b)])
+                        .sum();
+                    worst = worst.max((4.0 * w[k] - s).abs());
+                }
+            }
+        }
+        assert!(worst < 1e-10, "{stats:?}: worst residual {worst:e}");
+    }
+}

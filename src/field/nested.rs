@@ -1,0 +1,569 @@
+//! The nested solves that carry `W` below what one solve resolves, level after level, to any
+//! depth, each level costing what its band of cells costs (design page, "Fields of any
+//! depth").
+//!
+//! After the first solve, the cells it resolves to full relative precision are *accepted*
+//! (those with `W ≥ τ`, and those a few steps from them, see [`deep_cells`]); the others are
+//! *pending*, their values only estimates. Each level then:
+//!
+//! 1. takes a **band** of pending cells next to the accepted ones: the *core*, every pending
+//!    cell within [`CORE_STEPS`] of an accepted cell or reached through cells whose estimate is
+//!    still reliable (at least [`BAND`] of the scale of the solve that gave it), and a
+//!    *margin* of [`MARGIN`] more layers;
+//! 2. solves each connected part of the band on its own bounding box, with the accepted cells
+//!    around it as Dirichlet values, scaled so that the largest is about 1, and `W = 0` at the
+//!    *cut* (the pending cells beyond the band): a lower bound of the true `W`, exact at the
+//!    accepted cells and close to it away from the cut;
+//! 3. accepts the cells of the part that the solve resolves (at least `τ` of its scale, or a
+//!    few steps from such a cell), that are more than [`MARGIN`] steps from the cut and at
+//!    least [`GAP`] times the values near it, stored with the exponent of the part's scale
+//!    ([`ScaledW`]).
+//!
+//! Every level accepts at least the cells next to the largest accepted neighbour, so the
+//! levels end when every reachable cell is accepted. A cell is solved in about
+//! `(core + margin) / advance` levels (two or three in a corridor), so the levels together
+//! cost a few solves of the deep cells, not depth × map.
+//!
+//! Why the cut is safe: each part's solution is harmonic inside the part with its largest
+//! values on the accepted cells around it, so the composite `W` has no local maximum but the
+//! target, whatever the error near a cut; and a cut more than a margin away from the cells it
+//! accepts changes them by little (in a corridor of width `w`, by about `e^(−2π x / w)` at a
+//! distance `x`).
+
+use super::grid::Grid;
+use super::multigrid;
+use super::scaled::{ScaledW, exponent_of, ldexp};
+
+/// The depth each level resolves: a cell is resolved when its `W` is at least this fraction of
+/// the scale of its solve (a solve to a relative residual of 1e-12 gives about 1e-12 of its
+/// scale absolutely, so such a cell has six digits).
+pub const DEPTH_STEP: f64 = 1e-6;
+/// How many steps through free cells a cell below the depth may be from a cell above it and
+/// still count as resolved (see [`deep_cells`]).
+pub const REACH: usize = 8;
+/// No cell below this fraction of its solve's scale counts as resolved, however close to a
+/// resolved cell: 10 times the absolute precision of a solve to a relative residual of 1e-12.
+/// (A cell next to a wall a few steps from a resolved one is far above it: in a corridor one
+/// cell wide, `REACH` steps lose a factor 3e-5. A cell this small near a resolved one is at the
+/// end of a dead end, where the solve's own error could leave it negative.)
+pub const FLOOR: f64 = 1e-11;
+/// Steps from the accepted cells that a band's core covers at first. The extent adapts: it
+/// doubles after a level in which the cut, rather than the depth, limited what was accepted
+/// (`W` falls slowly there: a wide region), and halves back towards this after one in which
+/// the depth did (a narrow corridor).
+pub const CORE_STEPS: u32 = 8;
+/// The largest extent of a band's core, in steps.
+pub const MAX_CORE_STEPS: u32 = 1 << 16;
+/// An estimate of at least this fraction of its solve's scale is reliable enough to extend a
+/// band's core through.
+pub const BAND: f64 = 1e-10;
+/// Layers of pending cells beyond a band's core; cells this close to the cut are not accepted.
+pub const MARGIN: u32 = 8;
+/// Each level works from the frontier cells whose `W` is within this factor of the largest.
+pub const LEVEL_RANGE: f64 = 1e-12;
+/// A cell is accepted only if it is at least this many times the largest value within
+/// [`MARGIN`] of the cut. Where `W` falls exponentially away from the frontier (a corridor),
+/// the cut changes a cell by the square of their ratio, so this keeps the relative error below
+/// about 1e-6 whatever the corridor's width: the wider the corridor, the slower `W` falls and
+/// the farther from the cut a cell must be.
+pub const GAP: f64 = 1e3;
+/// CG iterations allowed per solve.
+pub const MAX_ITERATIONS: usize = 500;
+
+/// What the nested levels did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LevelStats {
+    /// Levels run.
+    pub levels: usize,
+    /// Solves (connected parts of bands).
+    pub solves: usize,
+    /// CG iterations over all solves.
+    pub iterations: usize,
+    /// The worst relative residual.
+    pub relative_residual: f64,
+    /// Cells solved, summed over the solves (a cell solved in three levels counts three times).
+    pub cells_solved: usize,
+}
+
+/// The cells below `depth` that need a nested solve: those more than [`REACH`] steps through
+/// free cells from any cell at or above it.
+///
+/// A cell next to a wall has a small `W` however close it is to the target, because `W = 0` on
+/// the wall; but so has the solve's error, which is harmonic with the same zero there, so such a
+/// cell is known to the relative precision of the cells a few steps away from the wall.
+/// Counting them as deep would make the nested solves cover every wall of the world. The
+/// distance is counted through free cells: across a wall, a cell's neighbourhood says nothing
+/// about it. (In a corridor one cell wide, the narrowest there is, `W` falls by 2 − √3 per
+/// cell, so `REACH` steps lose at most a factor 3e-5 of relative precision.)
+pub fn deep_cells(grid: &Grid, unknown: &[bool], w: &[f64], depth: f64) -> Vec<bool> {
+    let below = |k: usize| unknown[k] && w[k] < depth;
+    let mut deep: Vec<bool> = (0..grid.len()).map(below).collect();
+    let floor = FLOOR * depth / DEPTH_STEP;
+    // Breadth-first from the cells below the depth that touch one above it.
+    let mut front = Vec::new();
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            let k = grid.index(i, j);
+            if deep[k]
+                && w[k] >= floor
+                && grid
+                    .neighbours(i, j)
+                    .any(|(a, b)| unknown[grid.index(a, b)] && !below(grid.index(a, b)))
+            {
+                front.push((i, j));
+            }
+        }
+    }
+    for &(i, j) in &front {
+        deep[grid.index(i, j)] = false;
+    }
+    for _ in 1..REACH {
+        let mut next = Vec::new();
+        for &(i, j) in &front {
+            for (a, b) in grid.neighbours(i, j) {
+                let k = grid.index(a, b);
+                if deep[k] && w[k] >= floor {
+                    deep[k] = false;
+                    next.push((a, b));
+                }
+            }
+        }
+        front = next;
+    }
+    deep
+}
+
+/// The state of the nested levels over the whole grid. Every per-level pass touches only the
+/// cells of the band and the frontier (marks are level stamps, never cleared), so a level costs
+/// what its band costs however large the map.
+struct Levels<'a> {
+    grid: &'a Grid,
+    w: &'a mut ScaledW,
+    tolerance: f64,
+    /// Reachable cells not accepted yet.
+    pending: Vec<bool>,
+    /// Accepted cells with a pending neighbour.
+    frontier: Vec<usize>,
+    /// `band[k] == level` when cell `k` is in this level's band.
+    band: Vec<u32>,
+    /// Steps from the accepted cells (in the band).
+    dist: Vec<u32>,
+    /// Index of the part of the band a cell is in (in the band).
+    part: Vec<u32>,
+    /// Scratch marks for the per-part passes: `seen[k] == stamp`.
+    seen: Vec<u32>,
+    stamp: u32,
+    level: u32,
+    /// The extent of the next band's core, in steps.
+    core_steps: u32,
+    stats: LevelStats,
+}
+
+/// Runs the nested levels on `w` (the first solve's values, exponent 0) until every cell is
+/// accepted; `pending` are the cells the first solve did not resolve.
+pub fn solve_levels(
+    grid: &Grid,
+    pending: Vec<bool>,
+    w: &mut ScaledW,
+    tolerance: f64,
+) -> LevelStats {
+    let n = grid.len();
+    let mut levels = Levels {
+        grid,
+        w,
+        tolerance,
+        frontier: Vec::new(),
+        band: vec![0; n],
+        dist: vec![0; n],
+        part: vec![0; n],
+        seen: vec![0; n],
+        stamp: 0,
+        level: 0,
+        core_steps: CORE_STEPS,
+        stats: LevelStats::default(),
+        pending,
+    };
+    // The first frontier: accepted cells (the target among them) next to pending ones.
+    for k in 0..n {
+        if levels.accepted(k) && levels.neighbours(k).any(|m| levels.pending[m]) {
+            levels.frontier.push(k);
+        }
+    }
+    while !levels.frontier.is_empty() {
+        levels.run_level();
+    }
+    levels.stats
+}
+
+/// The 4-neighbours of cell `k` of `g`, as indices.
+fn around(g: Grid, k: usize) -> impl Iterator<Item = usize> {
+    let (nx, ny) = (g.nx, g.ny);
+    let (i, j) = (k % nx, k / nx);
+    [
+        (i.wrapping_sub(1), j),
+        (i + 1, j),
+        (i, j.wrapping_sub(1)),
+        (i, j + 1),
+    ]
+    .into_iter()
+    .filter(move |&(a, b)| a < nx && b < ny)
+    .map(move |(a, b)| b * nx + a)
+}
+
+impl Levels<'_> {
+    /// The 4-neighbours of cell `k`, as indices.
+    fn neighbours(&self, k: usize) -> impl Iterator<Item = usize> + use<> {
+        around(*self.grid, k)
+    }
+
+    fn in_band(&self, k: usize) -> bool {
+        self.band[k] == self.level
+    }
+
+    fn accepted(&self, k: usize) -> bool {
+        !self.pending[k] && self.w.mantissa[k] > 0.0
+    }
+
+    /// One level: the band, its parts solved, their resolved cells accepted.
+    fn run_level(&mut self) {
+        self.level += 1;
+        self.stats.levels += 1;
+        // This level works from the frontier cells within LEVEL_RANGE of the largest, and
+        // accepts nothing below GAP times that: cells are accepted in order of decreasing `W`,
+        // a few decades per level, so a cut never lies where a larger `W` still flows in.
+        let top = self
+            .frontier
+            .iter()
+            .map(|&k| self.w.log2(k))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let lowest = top + LEVEL_RANGE.log2();
+        let band = self.band_cells(lowest);
+        let parts = self.parts(&band);
+        let mut accepted = Vec::new();
+        let mut cut_limited = false;
+        for cells in &parts {
+            let scale = self.solve_part(cells);
+            let (resolved, limited) = self.resolved(cells, scale, lowest);
+            accepted.extend(resolved);
+            cut_limited |= limited;
+        }
+        self.core_steps = if cut_limited {
+            (2 * self.core_steps).min(MAX_CORE_STEPS)
+        } else {
+            (self.core_steps / 2).max(CORE_STEPS)
+        };
+        for &k in &accepted {
+            self.pending[k] = false;
+        }
+        // The frontier: the old one and the new cells, where they still touch pending cells.
+        let mut frontier = std::mem::take(&mut self.frontier);
+        frontier.extend(accepted);
+        frontier.retain(|&k| self.neighbours(k).any(|m| self.pending[m]));
+        self.frontier = frontier;
+    }
+
+    /// This level's band: its core (breadth-first from the frontier) and its margin.
+    fn band_cells(&mut self, lowest: f64) -> Vec<usize> {
+        let level = self.level;
+        let mut band = Vec::new();
+        for i in 0..self.frontier.len() {
+            if self.w.log2(self.frontier[i]) < lowest {
+                continue;
+            }
+            for m in self.neighbours(self.frontier[i]) {
+                if self.pending[m] && !self.in_band(m) {
+                    self.band[m] = level;
+                    self.dist[m] = 1;
+                    band.push(m);
+                }
+            }
+        }
+        // The core: within CORE_STEPS, or through reliable estimates.
+        let mut head = 0;
+        while head < band.len() {
+            let k = band[head];
+            head += 1;
+            let d = self.dist[k] + 1;
+            for m in self.neighbours(k) {
+                if self.pending[m]
+                    && self.band[m] != level
+                    && (d <= self.core_steps || self.w.mantissa[m] >= BAND)
+                {
+                    self.band[m] = level;
+                    self.dist[m] = d;
+                    band.push(m);
+                }
+            }
+        }
+        // The margin.
+        let mut layer: Vec<usize> = band.clone();
+        for _ in 0..MARGIN {
+            let mut next = Vec::new();
+            for &k in &layer {
+                let d = self.dist[k] + 1;
+                for m in self.neighbours(k) {
+                    if self.pending[m] && self.band[m] != level {
+                        self.band[m] = level;
+                        self.dist[m] = d;
+                        next.push(m);
+                    }
+                }
+            }
+            band.extend_from_slice(&next);
+            layer = next;
+        }
+        // The tail: when every pending cell left beyond the margin fits in as many cells again
+        // as the band has, the band takes them all and has no cut (a room's deep corner); a
+        // maze's rest does not fit, and is left for the next levels.
+        let budget = band.len();
+        let mut tail = Vec::new();
+        let mut head = 0;
+        let mut frontier = layer;
+        while let Some(&k) = frontier.get(head) {
+            head += 1;
+            for m in self.neighbours(k) {
+                if self.pending[m] && self.band[m] != level {
+                    self.band[m] = level;
+                    tail.push(m);
+                    frontier.push(m);
+                }
+            }
+            if tail.len() > budget {
+                for &m in &tail {
+                    self.band[m] = 0;
+                }
+                return band;
+            }
+        }
+        band.extend_from_slice(&tail);
+        band
+    }
+
+    /// The connected parts of the band (4-neighbours), each a list of cells.
+    fn parts(&mut self, band: &[usize]) -> Vec<Vec<usize>> {
+        self.stamp += 1;
+        let stamp = self.stamp;
+        let mut parts = Vec::new();
+        for &start in band {
+            if self.seen[start] == stamp {
+                continue;
+            }
+            self.seen[start] = stamp;
+            let index = parts.len() as u32;
+            let mut cells = vec![start];
+            let mut head = 0;
+            while head < cells.len() {
+                let k = cells[head];
+                head += 1;
+                self.part[k] = index;
+                for m in self.neighbours(k) {
+                    if self.in_band(m) && self.seen[m] != stamp {
+                        self.seen[m] = stamp;
+                        cells.push(m);
+                    }
+                }
+            }
+            parts.push(cells);
+        }
+        parts
+    }
+
+    /// Solves one part of the band on its bounding box, with the accepted cells around it as
+    /// Dirichlet values and 0 at the cut, at the scale `2^e` of its largest accepted neighbour;
+    /// stores every cell of the part at that scale and returns `e`.
+    fn solve_part(&mut self, cells: &[usize]) -> i32 {
+        let g = self.grid;
+        let scale = cells
+            .iter()
+            .flat_map(|&k| self.neighbours(k))
+            .filter(|&m| self.accepted(m))
+            .map(|m| self.w.exponent[m] + exponent_of(self.w.mantissa[m]))
+            .max()
+            .unwrap_or(0);
+        let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
+        for &k in cells {
+            let (i, j) = (k % g.nx, k / g.nx);
+            lo = [lo[0].min(i), lo[1].min(j)];
+            hi = [hi[0].max(i), hi[1].max(j)];
+        }
+        let (i0, j0) = (lo[0].saturating_sub(1), lo[1].saturating_sub(1));
+        let (i1, j1) = ((hi[0] + 1).min(g.nx - 1), (hi[1] + 1).min(g.ny - 1));
+        let sub = Grid {
+            nx: i1 - i0 + 1,
+            ny: j1 - j0 + 1,
+            cell: g.cell,
+            origin: g.center(i0, j0).map(|c| c - 0.5 * g.cell),
+        };
+        let local = |k: usize| sub.index(k % g.nx - i0, k / g.nx - j0);
+        let mut unknown = vec![false; sub.len()];
+        for &k in cells {
+            unknown[local(k)] = true;
+        }
+        // The accepted cells around the part at its scale; 0 everywhere else (blocked cells,
+        // the pending cells beyond the cut, and cells of the box that do not touch the part);
+        // the part's own estimates as the starting guess, within the bounds of the solution
+        // (the values around it): an estimate made at a larger scale can be far above them,
+        // and CG, which updates its residual rather than recomputing it, would keep the
+        // rounding of a huge first residual.
+        let mut values = vec![0.0; sub.len()];
+        let mut largest: f64 = 0.0;
+        for &k in cells {
+            for m in self.neighbours(k) {
+                if self.accepted(m) {
+                    values[local(m)] = self.w.at_scale(m, scale);
+                    largest = largest.max(values[local(m)]);
+                }
+            }
+        }
+        for &k in cells {
+            values[local(k)] = self.w.at_scale(k, scale).clamp(0.0, largest);
+        }
+        let stats = multigrid::solve(&sub, &unknown, &mut values, self.tolerance, MAX_ITERATIONS);
+        self.stats.solves += 1;
+        self.stats.iterations += stats.iterations;
+        self.stats.relative_residual = self.stats.relative_residual.max(stats.relative_residual);
+        self.stats.cells_solved += cells.len();
+        for &k in cells {
+            self.w.mantissa[k] = values[local(k)];
+            self.w.exponent[k] = scale;
+        }
+        scale
+    }
+
+    /// The cells of a solved part that are resolved (at least `τ` of the scale `2^e`, or
+    /// within [`REACH`] steps of such a cell or of an accepted cell as large) and more than
+    /// [`MARGIN`] steps from the cut, and at least [`GAP`] times the values near the cut and
+    /// the level's `lowest` source (`log2 W`); and whether the cut kept resolved cells out.
+    fn resolved(&mut self, cells: &[usize], e: i32, lowest: f64) -> (Vec<usize>, bool) {
+        // Steps from the cut, up to MARGIN: `seen == stamp` marks the cells near it.
+        self.stamp += 1;
+        let near = self.stamp;
+        let mut layer: Vec<usize> = cells
+            .iter()
+            .copied()
+            .filter(|&k| {
+                self.neighbours(k)
+                    .any(|m| self.pending[m] && !self.in_band(m))
+            })
+            .collect();
+        for &k in &layer {
+            self.seen[k] = near;
+        }
+        for _ in 0..MARGIN {
+            let mut next = Vec::new();
+            for &k in &layer {
+                for m in self.neighbours(k) {
+                    if self.in_band(m) && self.seen[m] != near {
+                        self.seen[m] = near;
+                        next.push(m);
+                    }
+                }
+            }
+            layer = next;
+        }
+        let near_cut: Vec<bool> = cells.iter().map(|&k| self.seen[k] == near).collect();
+        // The part's values near the cut: a cell far above them is little changed by it.
+        let at_cut = cells
+            .iter()
+            .zip(&near_cut)
+            .filter(|&(_, near)| *near)
+            .map(|(&k, _)| self.w.at_scale(k, e))
+            .fold(
+                ldexp(1.0, (lowest.floor() as i32).saturating_sub(e)),
+                f64::max,
+            );
+        // Resolved: the cells at least τ of the scale. (No REACH rule here, unlike the first
+        // solve's: a weak cell a few steps from a strong one is small because `W` decays
+        // along a corridor as often as because a wall is near, and the next level, at a
+        // smaller scale, resolves it anyway.)
+        self.stamp += 1;
+        let resolved = self.stamp;
+        for &k in cells {
+            if self.w.at_scale(k, e) >= DEPTH_STEP {
+                self.seen[k] = resolved;
+            }
+        }
+        let mut cut_limited = false;
+        let mut accepted = Vec::new();
+        for (&k, near_cut) in cells.iter().zip(near_cut) {
+            if self.seen[k] == resolved {
+                if near_cut || self.w.at_scale(k, e) < GAP * at_cut {
+                    cut_limited = true;
+                } else {
+                    accepted.push(k);
+                }
+            }
+        }
+        (accepted, cut_limited)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::harmonic::solve_w;
+    use crate::field::laplace::reachable_from;
+
+    /// A serpentine corridor one cell wide, 20,000 cells long: `W` falls by 2 − √3 per cell,
+    /// to about 1e-11400 at its end, far below f64. Every cell gets a positive `W` at its
+    /// scale, the decay per cell is the corridor's, and the field is harmonic everywhere.
+    #[test]
+    fn a_corridor_far_deeper_than_f64_keeps_its_decay_to_the_end() {
+        let n = 201;
+        let grid = Grid::covering([n as f64, n as f64], 1.0);
+        let mut blocked = vec![true; grid.len()];
+        // Rows 1, 3, 5, … are free; they connect at alternate ends.
+        for j in (1..n - 1).step_by(2) {
+            for i in 1..n - 1 {
+                blocked[grid.index(i, j)] = false;
+            }
+            if j + 2 < n - 1 {
+                let end = if (j / 2) % 2 == 0 { n - 2 } else { 1 };
+                blocked[grid.index(end, j + 1)] = false;
+            }
+        }
+        let target = (1, 1);
+        let reachable = reachable_from(&grid, &blocked, target);
+        let s = solve_w(&grid, &reachable, target, 1e-12, None);
+        let w = &s.w;
+        // Walk the corridor from the target.
+        let mut path = vec![grid.index(1, 1)];
+        let mut seen = vec![false; grid.len()];
+        seen[path[0]] = true;
+        while let Some(&k) = path.last() {
+            let Some(next) = around(grid, k).find(|&m| reachable[m] && !seen[m]) else {
+                break;
+            };
+            seen[next] = true;
+            path.push(next);
+        }
+        assert!(path.len() > 19_000, "{}", path.len());
+        let end = *path.last().unwrap();
+        assert!(w.log10(end) < -10_000.0, "{}", w.log10(end));
+        assert!(s.nested.levels > 100, "{:?}", s.nested);
+        // The decay per cell, away from the bends and the ends (near the dead end `W` bends
+        // up like a cosh), 2 − √3, to a few parts in a million (each level knows its cells to
+        // about 1e-6; the first solve's cells a few steps beyond its depth, within 30 cells of
+        // the target, to about 1e-5 only).
+        let expected = 2.0 - 3f64.sqrt();
+        for pair in path[30..path.len() - 20].windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let ratio = (w.log2(b) - w.log2(a)).exp2();
+            let straight = a / grid.nx == b / grid.nx
+                && around(grid, a).filter(|&m| reachable[m]).count() == 2
+                && around(grid, b).filter(|&m| reachable[m]).count() == 2;
+            if straight && (a % grid.nx) > 3 && (a % grid.nx) < n - 4 {
+                assert!((ratio / expected - 1.0).abs() < 5e-6, "{ratio} at cell {a}");
+            }
+        }
+        // Harmonic at every cell beyond the first solve's, to relative precision.
+        for &k in &path[30..] {
+            let e = w.exponent[k];
+            let sum: f64 = around(grid, k).map(|m| w.at_scale(m, e)).sum();
+            let own = w.mantissa[k];
+            assert!((4.0 * own - sum).abs() <= 1e-6 * 4.0 * own, "cell {k}");
+        }
+        // The solved cells: a few times the corridor, not levels × corridor.
+        assert!(s.nested.cells_solved < 5 * path.len(), "{:?}", s.nested);
+    }
+}
