@@ -129,7 +129,8 @@ impl<const N: usize> Controller<N> {
         }
         let mut speed_limited = false;
         if let Some(limit) = &self.speed_limit {
-            (total, speed_limited) = limit.limit(total, &input.velocity, input.dt);
+            let distance = input.offset.norm();
+            (total, speed_limited) = limit.limit(total, &input.velocity, distance, input.dt);
         }
         let force = if total.iter().all(|c| c.is_finite()) {
             total
@@ -185,7 +186,13 @@ impl Controller<2> {
                 mass,
             }),
             bias: settings.bias.map(|b| Bias::new(b.alpha, b.dwell)),
-            speed_limit: settings.speed_limit.map(|v_max| SpeedLimit { v_max, mass }),
+            speed_limit: (settings.speed_limit.is_some() || settings.brake.is_some()).then(|| {
+                SpeedLimit {
+                    v_max: settings.speed_limit.unwrap_or(f64::INFINITY),
+                    brake: settings.brake,
+                    mass,
+                }
+            }),
             max_force: settings.max_force,
         }
     }
@@ -206,6 +213,7 @@ mod tests {
             vd: None,
             f0: None,
             speed_limit: None,
+            brake: None,
             max_force: None,
             clamp: None,
             bias: None,

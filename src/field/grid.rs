@@ -29,14 +29,24 @@ impl Grid {
         }
     }
 
-    /// The grid of `cell`-sized cells that covers a box of `size` metres and has a cell centred
-    /// exactly on `anchor` (a point inside the box).
+    /// The grid of `cell`-sized cells that covers a box of `size` metres from `[0, 0]` and has
+    /// a cell centred exactly on `anchor` (a point inside the box).
     pub fn anchored(size: [f64; 2], cell: f64, anchor: [f64; 2]) -> Self {
-        let origin = anchor.map(|a| a - ((a / cell).floor() + 0.5) * cell);
-        let origin = origin.map(|o| if o > 0.0 { o - cell } else { o });
+        Self::anchored_in(([0.0, 0.0], size), cell, anchor)
+    }
+
+    /// The grid of `cell`-sized cells that covers the box `[lo, hi]` and has a cell centred
+    /// exactly on `anchor` (a point inside the box).
+    pub fn anchored_in((lo, hi): ([f64; 2], [f64; 2]), cell: f64, anchor: [f64; 2]) -> Self {
+        let offset = |k: usize| {
+            let a = anchor[k] - lo[k];
+            let o = a - ((a / cell).floor() + 0.5) * cell;
+            lo[k] + if o > 0.0 { o - cell } else { o }
+        };
+        let origin = [offset(0), offset(1)];
         Self {
-            nx: (((size[0] - origin[0]) / cell).ceil() as usize).max(1),
-            ny: (((size[1] - origin[1]) / cell).ceil() as usize).max(1),
+            nx: (((hi[0] - origin[0]) / cell).ceil() as usize).max(1),
+            ny: (((hi[1] - origin[1]) / cell).ceil() as usize).max(1),
             cell,
             origin,
         }
@@ -134,6 +144,24 @@ mod tests {
             assert!(g.origin.iter().all(|o| *o <= 0.0 && *o > -0.05));
             assert!(g.cell_of([9.999, 9.999]).is_some() && g.cell_of([0.0, 0.0]).is_some());
         }
+    }
+
+    #[test]
+    fn a_box_away_from_the_origin_is_covered_the_same_way() {
+        let g = Grid::anchored_in(([-10.0, 5.0], [0.0, 15.0]), 0.05, [-3.3, 7.7]);
+        let (i, j) = g.cell_of([-3.3, 7.7]).unwrap();
+        let c = g.center(i, j);
+        assert!(
+            (c[0] + 3.3).abs() < 1e-12 && (c[1] - 7.7).abs() < 1e-12,
+            "{c:?}"
+        );
+        assert!(g.origin[0] <= -10.0 && g.origin[0] > -10.05);
+        assert!(g.origin[1] <= 5.0 && g.origin[1] > 4.95);
+        assert!(g.cell_of([-0.001, 14.999]).is_some() && g.cell_of([-10.0, 5.0]).is_some());
+        assert_eq!(
+            Grid::anchored([10.0, 10.0], 0.05, [1.5, 8.5]),
+            Grid::anchored_in(([0.0, 0.0], [10.0, 10.0]), 0.05, [1.5, 8.5])
+        );
     }
 
     #[test]

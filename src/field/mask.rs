@@ -63,7 +63,7 @@ impl FreeSpace {
         offsets: &[f64],
         others: &[Disc],
     ) -> Result<Self, FieldError> {
-        let grid = Grid::anchored(world.size, world.field.cell, agent.target);
+        let grid = Grid::anchored_in(world.bounds(), world.field.cell, agent.target);
         let mut walls = all_wall_shapes(world);
         let margin = agent.radius + std::f64::consts::SQRT_2 * grid.cell;
         let covers = |d: &Disc, p: [f64; 2]| {
@@ -75,7 +75,7 @@ impl FreeSpace {
                 .filter(|d| !covers(d, agent.target) && !covers(d, position))
                 .map(Disc::shape),
         );
-        let blocked = rasterize(&grid, world.size, &walls, agent.radius, offsets);
+        let blocked = rasterize(&grid, world.bounds(), &walls, agent.radius, offsets);
         let target_cell = grid
             .cell_of(agent.target)
             .filter(|&(i, j)| !blocked[grid.index(i, j)])
@@ -148,13 +148,13 @@ impl CellCounts {
     }
 }
 
-/// `blocked[grid.index(i, j)]` for every cell, for a disc of `radius` metres in a box of
-/// `size`, with wall `k`'s boundary moved out by `offsets[k]` metres (in where negative;
+/// `blocked[grid.index(i, j)]` for every cell, for a disc of `radius` metres in the box
+/// `[lo, hi]`, with wall `k`'s boundary moved out by `offsets[k]` metres (in where negative;
 /// missing offsets are zero: the exact walls): the mask of walls sensed with errors. A cell is
 /// blocked when its signed distance to a wall is below `radius + offset`.
 pub fn rasterize(
     grid: &Grid,
-    size: [f64; 2],
+    (lo, hi): ([f64; 2], [f64; 2]),
     walls: &[WallShape],
     radius: f64,
     offsets: &[f64],
@@ -163,7 +163,8 @@ pub fn rasterize(
     for j in 0..grid.ny {
         for i in 0..grid.nx {
             let [x, y] = grid.center(i, j);
-            if x < radius || y < radius || x > size[0] - radius || y > size[1] - radius {
+            if x < lo[0] + radius || y < lo[1] + radius || x > hi[0] - radius || y > hi[1] - radius
+            {
                 blocked[grid.index(i, j)] = true;
             }
         }
@@ -219,7 +220,13 @@ mod tests {
         })
         .unwrap();
         let count = |offset: f64| {
-            let blocked = rasterize(&grid, size, std::slice::from_ref(&wall), 0.2, &[offset]);
+            let blocked = rasterize(
+                &grid,
+                ([0.0, 0.0], size),
+                std::slice::from_ref(&wall),
+                0.2,
+                &[offset],
+            );
             // Only the cells around the wall, not the box edges.
             (0..grid.len())
                 .filter(|&k| {
@@ -246,7 +253,7 @@ mod tests {
             radius: 0.3,
         })
         .unwrap();
-        let blocked = rasterize(&grid, size, &[wall], 0.2, &[]);
+        let blocked = rasterize(&grid, ([0.0, 0.0], size), &[wall], 0.2, &[]);
         for j in 0..grid.ny {
             for i in 0..grid.nx {
                 let [x, y] = grid.center(i, j);

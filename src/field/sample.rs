@@ -147,6 +147,15 @@ impl Sampler {
         (!s.is_empty()).then(|| (s.iter().map(|&(k, a)| at_scale(k) * a).sum(), e))
     }
 
+    /// `W` and `∇W` at `p` at the same scale (the largest exponent of the cells around `p`):
+    /// their ratio at full precision at any depth, if `p` is next to a reachable cell.
+    pub fn w_and_grad_scaled(&self, p: [f64; 2]) -> Option<(f64, Vector2<f64>)> {
+        let (w, e) = self.w_scaled(p)?;
+        let (g, eg) = self.grad_w_scaled(p)?;
+        debug_assert_eq!(e, eg);
+        Some((w, g))
+    }
+
     /// `∇W = -∇V` at `p` (0 where it is below f64's range), if `p` is next to a reachable
     /// cell.
     pub fn grad_w(&self, p: [f64; 2]) -> Option<Vector2<f64>> {

@@ -204,6 +204,7 @@ fn log_body(
 /// at the free points of a regular lattice for an attractive-repulsive one.
 fn guidance_arrows(sim: &Simulation, run: &AgentRun) -> (Vec<[f32; 2]>, Vec<[f32; 2]>) {
     let [w, h] = sim.world.size;
+    let [x0, y0] = sim.world.origin;
     let spacing = (w.max(h) / GUIDANCE_ARROWS as f64).min(w.min(h) / 4.0);
     let length = 0.6 * spacing;
     let free = |c: [f64; 2]| match run.field.harmonic() {
@@ -220,7 +221,10 @@ fn guidance_arrows(sim: &Simulation, run: &AgentRun) -> (Vec<[f32; 2]>, Vec<[f32
     let (nx, ny) = ((w / spacing) as usize, (h / spacing).max(1.0) as usize);
     for j in 0..ny {
         for i in 0..nx {
-            let c = [(i as f64 + 0.5) * spacing, (j as f64 + 0.5) * spacing];
+            let c = [
+                x0 + (i as f64 + 0.5) * spacing,
+                y0 + (j as f64 + 0.5) * spacing,
+            ];
             if !free(c) {
                 continue;
             }

@@ -12,6 +12,8 @@ pub const WORLD: &str = "world";
 pub const BOX: &str = "world/box";
 /// The walls' outlines.
 pub const WALLS: &str = "world/walls";
+/// A map's cells, as an image.
+pub const MAP: &str = "world/map";
 /// The root of everything agents draw.
 pub const AGENTS: &str = "agents";
 
@@ -187,7 +189,7 @@ pub const AGENT_SERIES: &[Series<Agent, AgentState>] = &[
         key: "speed_limited",
         label: "speed limit active",
         view: "limits active (0/1)",
-        shown: |a| a.controller.speed_limit.is_some(),
+        shown: |a| a.controller.speed_limit.is_some() || a.controller.brake.is_some(),
         value: |_, s| flag(s.speed_limited),
     },
     Series {

@@ -40,6 +40,16 @@ pub const BLOCKED: Rgb = [70, 70, 70];
 /// Free cells of a field image from which the target cannot be reached.
 pub const UNREACHABLE: Rgb = [0, 0, 0];
 
+/// A map's walls (drawn as an image).
+pub const MAP_WALL: Rgb = [150, 150, 150];
+/// A map's unknown cells.
+pub const MAP_UNKNOWN: Rgb = [90, 90, 110];
+
+/// A palette colour with opacity `alpha`, as RGBA bytes.
+pub fn rgba(c: Rgb, alpha: u8) -> [u8; 4] {
+    [c[0], c[1], c[2], alpha]
+}
+
 /// A palette colour for Rerun.
 pub fn rerun(c: Rgb) -> rerun::Color {
     rerun::Color::from_rgb(c[0], c[1], c[2])

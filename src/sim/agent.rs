@@ -254,14 +254,14 @@ impl AgentRun {
     }
 
     /// Step 4: after Rapier's step that ended at `time` (s), reads the state back, counts
-    /// contact starts, watches for faults against `walls` and the box of `size`, and updates
+    /// contact starts, watches for faults against `walls` and the box `bounds`, and updates
     /// the metrics.
     pub(super) fn observe(
         &mut self,
         physics: &PhysicsWorld,
         time: f64,
         walls: &[WallShape],
-        size: [f64; 2],
+        bounds: ([f64; 2], [f64; 2]),
     ) -> AgentState {
         let (position, velocity) = self.read_state(physics);
         let p: [f64; 2] = position.into();
@@ -276,7 +276,7 @@ impl AgentRun {
             field: &self.field,
             position,
             signed_clearance: signed,
-            size,
+            bounds,
         });
         self.log.events.extend(faults);
         let contact_points = self.contacts(physics, position);

@@ -36,8 +36,8 @@ pub struct Observation<'a> {
     pub position: Vector2<f64>,
     /// Signed distance from the disc to the nearest wall, m (negative when overlapping).
     pub signed_clearance: f64,
-    /// The world's box, m.
-    pub size: [f64; 2],
+    /// The world's box, its lower-left and upper-right corners, m.
+    pub bounds: ([f64; 2], [f64; 2]),
 }
 
 impl FaultMonitor {
@@ -68,10 +68,12 @@ impl FaultMonitor {
         let reversed =
             matches!((direction, self.last_direction), (Some(u), Some(last)) if u.dot(&last) < 0.0);
         self.last_direction = direction;
-        // Only a harmonic field can be flat to working precision (in `W = 1 - V`).
+        // Only a harmonic field can be flat to working precision (in `W = 1 - V`), measured at
+        // the scale of the cells around `p` (deep in a maze `W` and `∇W` are far below f64).
         let flat = o.field.harmonic().is_some_and(|h| {
-            gradient
-                .is_some_and(|g| g.norm() * cell <= FLAT_RELATIVE_CHANGE * h.one_minus_potential(p))
+            h.sampler
+                .w_and_grad_scaled(p)
+                .is_some_and(|(w, g)| g.norm() * cell <= FLAT_RELATIVE_CHANGE * w)
         });
         let lost = !near_target && (direction.is_none() || flat || reversed);
         if lost {
@@ -95,7 +97,8 @@ impl FaultMonitor {
         }
         self.penetrating = penetrating;
 
-        let outside = !(0.0..=o.size[0]).contains(&p[0]) || !(0.0..=o.size[1]).contains(&p[1]);
+        let (lo, hi) = o.bounds;
+        let outside = !(lo[0]..=hi[0]).contains(&p[0]) || !(lo[1]..=hi[1]).contains(&p[1]);
         if outside {
             self.faults.left_box_steps += 1;
             if !self.outside {

@@ -150,9 +150,9 @@ impl Simulation {
         for p in &mut self.pendulums {
             p.observe(&self.physics, self.time);
         }
-        let (walls, size) = (&self.walls, self.world.size);
+        let (walls, bounds) = (&self.walls, self.world.bounds());
         (self.agents.iter_mut())
-            .map(|a| a.observe(&self.physics, self.time, walls, size))
+            .map(|a| a.observe(&self.physics, self.time, walls, bounds))
             .collect()
     }
 

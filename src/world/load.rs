@@ -10,11 +10,13 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
+use std::sync::Arc;
 
 use toml_edit::{DocumentMut, Item, TableLike, Value};
 
 use super::error::{WorldError, WorldErrors, line_column};
-use super::schema::World;
+use super::map;
+use super::schema::{LoadedMap, World};
 use super::suggest::with_suggestion;
 use super::validate::{validate, warnings as unlocated_warnings};
 
@@ -233,6 +235,31 @@ fn parse(text: &str, file: &Path) -> Result<World, Vec<Problem>> {
             file.file_stem()
                 .map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned()),
         );
+    }
+    let given = |key: &str| doc.as_table().contains_key(key);
+    if let Some(settings) = &world.map {
+        let base = file.parent().unwrap_or(Path::new(""));
+        let occupancy = map::read(settings, base).map_err(|e| {
+            vec![Problem {
+                span: spans.span_of("map.file"),
+                key: Some("map.file".into()),
+                message: e.to_string(),
+            }]
+        })?;
+        if !given("size") {
+            world.size = occupancy.extent();
+        }
+        if !given("origin") {
+            world.origin = occupancy.origin;
+        }
+        let walls = occupancy.rectangles();
+        world.loaded_map = Some(Arc::new(LoadedMap { occupancy, walls }));
+    } else if !given("size") {
+        return Err(vec![Problem {
+            span: None,
+            key: Some("size".into()),
+            message: "missing field `size` (the box's width and height, m; a world with a [map] takes the map's)".into(),
+        }]);
     }
     let issues = validate(&world);
     if issues.is_empty() {

@@ -5,6 +5,7 @@
 
 mod error;
 mod load;
+pub mod map;
 mod schema;
 mod shapes;
 pub(crate) mod suggest;
@@ -14,10 +15,13 @@ pub use error::{WorldError, WorldErrors};
 pub use load::{Override, WorldFile, load, load_str};
 pub use schema::{
     Agent, Attraction, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K,
-    Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind, MAX_CELLS, OUTER_WALL_THICKNESS,
-    Pendulum, PendulumController, PendulumExpect, SensorSettings, Wall, World,
+    Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind, LoadedMap, MAX_CELLS, MapSettings,
+    OUTER_WALL_THICKNESS, Pendulum, PendulumController, PendulumExpect, SensorSettings,
+    UnknownCells, Wall, World,
 };
-pub use shapes::{WallShape, all_wall_shapes, all_walls, named_walls, outer_walls, wall_shape};
+pub use shapes::{
+    WallShape, all_wall_shapes, all_walls, drawn_walls, named_walls, outer_walls, wall_shape,
+};
 pub use validate::validate;
 
 /// The unlocated form of [`WorldFile::warnings`], for a world built in code.
@@ -27,6 +31,12 @@ impl World {
     /// The world's name (the file stem unless the file sets one).
     pub fn name(&self) -> &str {
         self.name.as_deref().unwrap_or("world")
+    }
+
+    /// The box's lower-left and upper-right corners, m.
+    pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        let [ox, oy] = self.origin;
+        (self.origin, [ox + self.size[0], oy + self.size[1]])
     }
 
     /// Number of physics steps in a run.

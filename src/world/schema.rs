@@ -4,8 +4,11 @@
 //! code cannot disagree about them for long: every default is a named function below.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use serde::{Deserialize, Deserializer, Serialize};
+
+use super::map::Occupancy;
 
 /// A whole world: the box, its walls, its agents and how long to simulate them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -14,9 +17,19 @@ pub struct World {
     /// Name of the world, used in the recording and the summary. Default: the file stem.
     #[serde(default)]
     pub name: Option<String>,
-    /// The box `[0, W] × [0, H]`, in metres.
-    #[serde(deserialize_with = "exactly")]
+    /// The box's width and height, m: `origin + [0, W] × [0, H]`. Required, unless the world
+    /// has a `[map]`, whose extent it then is.
+    #[serde(default, deserialize_with = "exactly")]
     pub size: [f64; 2],
+    /// The box's lower-left corner, m (default `[0, 0]`, or the map's origin with a `[map]`).
+    #[serde(default, deserialize_with = "exactly")]
+    pub origin: [f64; 2],
+    /// A map whose blocked cells are walls (ROS `map_server` or Moving AI).
+    #[serde(default)]
+    pub map: Option<MapSettings>,
+    /// The map as read, once loaded (not part of the file).
+    #[serde(skip)]
+    pub loaded_map: Option<Arc<LoadedMap>>,
     /// Add four walls of [`OUTER_WALL_THICKNESS`] just inside the box.
     #[serde(default = "default_true")]
     pub walls_around: bool,
@@ -119,6 +132,41 @@ impl std::fmt::Display for ExpectValue {
 /// per agent). A world whose `size` and `field.cell` give more cells is rejected unless it
 /// raises `field.max_cells`.
 pub const MAX_CELLS: u64 = 4096 * 4096;
+
+/// The `[map]` table: a map whose blocked cells become walls.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapSettings {
+    /// The map file, relative to the world file: a ROS `map_server` YAML (`.yaml`) or a Moving
+    /// AI grid map (`.map`).
+    pub file: String,
+    /// Moving AI only: metres per map cell (default 1).
+    #[serde(default)]
+    pub cell: Option<f64>,
+    /// ROS only: whether unknown cells are walls (default `blocked`).
+    #[serde(default)]
+    pub unknown: Option<UnknownCells>,
+}
+
+/// What the unknown cells of a ROS map are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum UnknownCells {
+    /// Walls: nothing is assumed passable that was not seen to be.
+    #[default]
+    Blocked,
+    /// Free space.
+    Free,
+}
+
+/// A world's map as loaded: the grid, and its blocked cells merged into boxes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadedMap {
+    /// The map's cells.
+    pub occupancy: Occupancy,
+    /// Its blocked cells as boxes (walls after the outer ones, before the file's own).
+    pub walls: Vec<Wall>,
+}
 
 /// Thickness of the walls that `walls_around = true` adds, m.
 pub const OUTER_WALL_THICKNESS: f64 = 0.1;
@@ -362,6 +410,10 @@ pub struct ControllerSettings {
     /// accelerate the body further along its velocity is dropped (paper §VI.2).
     #[serde(default)]
     pub speed_limit: Option<f64>,
+    /// Braking envelope, m/s²: the speed is also limited to `√(2 a d)` at a distance `d` from
+    /// the target, so the body arrives at rest (see `control::SpeedLimit`).
+    #[serde(default)]
+    pub brake: Option<f64>,
     /// Actuator saturation `F_max`, N: a control force longer than this is scaled down to it
     /// (direction kept), before the speed limit.
     #[serde(default)]

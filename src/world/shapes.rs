@@ -80,12 +80,12 @@ pub fn wall_shape(wall: &Wall) -> Option<WallShape> {
 }
 
 /// The four walls `walls_around = true` adds: boxes of [`OUTER_WALL_THICKNESS`] just inside
-/// `[0, W] × [0, H]`.
-pub fn outer_walls(size: [f64; 2]) -> Vec<Wall> {
+/// the box `origin + [0, W] × [0, H]`.
+pub fn outer_walls(origin: [f64; 2], size: [f64; 2]) -> Vec<Wall> {
     let [w, h] = size;
     let t = OUTER_WALL_THICKNESS / 2.0;
     let wall = |cx: f64, cy: f64, hx: f64, hy: f64| Wall::Box {
-        center: [cx, cy],
+        center: [origin[0] + cx, origin[1] + cy],
         half_extents: [hx, hy],
         angle: 0.0,
     };
@@ -103,22 +103,39 @@ pub fn all_wall_shapes(world: &World) -> Vec<WallShape> {
     all_walls(world).iter().filter_map(wall_shape).collect()
 }
 
-/// Every wall of the world, the outer ones (if any) first.
+/// Every wall of the world: the outer ones (if any), the map's, the file's.
 pub fn all_walls(world: &World) -> Vec<Wall> {
     named_walls(world).map(|(_, wall)| wall).collect()
 }
 
-/// Every wall of the world in the order of [`all_walls`], with the name a message gives it:
-/// `the outer wall`, or `walls.N` for the world file's `[[walls]]` entry N.
-pub fn named_walls(world: &World) -> impl Iterator<Item = (String, Wall)> + '_ {
-    let outer = if world.walls_around {
-        outer_walls(world.size)
+/// The walls drawn one by one: the outer ones and the file's (a map's are drawn as an image).
+pub fn drawn_walls(world: &World) -> Vec<Wall> {
+    let mut walls = if world.walls_around {
+        outer_walls(world.origin, world.size)
     } else {
         Vec::new()
     };
+    walls.extend(world.walls.iter().cloned());
+    walls
+}
+
+/// Every wall of the world in the order of [`all_walls`], with the name a message gives it:
+/// `the outer wall`, `the map` (a blocked cell of its `[map]`), or `walls.N` for the world
+/// file's `[[walls]]` entry N.
+pub fn named_walls(world: &World) -> impl Iterator<Item = (String, Wall)> + '_ {
+    let outer = if world.walls_around {
+        outer_walls(world.origin, world.size)
+    } else {
+        Vec::new()
+    };
+    let map = world
+        .loaded_map
+        .iter()
+        .flat_map(|m| m.walls.iter().cloned());
     outer
         .into_iter()
         .map(|w| ("the outer wall".to_string(), w))
+        .chain(map.map(|w| ("the map".to_string(), w)))
         .chain(
             world
                 .walls

@@ -26,6 +26,12 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
         "external_acceleration",
         world.external_acceleration,
     );
+    finite_point(&mut bad, "origin", world.origin);
+    if let Some(map) = &world.map
+        && let Some(cell) = map.cell
+    {
+        positive(&mut bad, "map.cell", cell);
+    }
     if !(world.field.tolerance > 0.0 && world.field.tolerance < 1.0) {
         bad(
             "field.tolerance".into(),
@@ -223,6 +229,7 @@ fn check_controller(
         ("vd", c.vd),
         ("f0", c.f0),
         ("speed_limit", c.speed_limit),
+        ("brake", c.brake),
         ("max_force", c.max_force),
     ] {
         if let Some(x) = value {
@@ -410,7 +417,7 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
     if !(agent.radius.is_finite() && agent.radius > 0.0) {
         return;
     }
-    let size = world.size;
+    let (lo, hi) = world.bounds();
     for (what, p, ok) in [
         ("start", agent.start, start_ok),
         ("target", agent.target, target_ok),
@@ -419,12 +426,12 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
             continue;
         }
         let r = agent.radius;
-        if p[0] < r || p[1] < r || p[0] > size[0] - r || p[1] > size[1] - r {
+        if p[0] < lo[0] + r || p[1] < lo[1] + r || p[0] > hi[0] - r || p[1] > hi[1] - r {
             bad(
                 key(what),
                 format!(
-                    "[{}, {}] puts the disc (radius {r} m) outside the box [0, {}] × [0, {}]",
-                    p[0], p[1], size[0], size[1]
+                    "[{}, {}] puts the disc (radius {r} m) outside the box [{}, {}] × [{}, {}]",
+                    p[0], p[1], lo[0], hi[0], lo[1], hi[1]
                 ),
             );
             continue;
