@@ -79,6 +79,12 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         field.iterations,
         field.relative_residual
     );
+    if field.nested.levels > 0 {
+        println!(
+            "nested: {} level(s), {} cells solved in {} part(s)",
+            field.nested.levels, field.nested.cells_solved, field.nested.solves
+        );
+    }
     println!(
         "1 - V at the start: {}",
         scientific(field.log10_one_minus_potential(agent.start))

@@ -41,6 +41,8 @@ pub struct HarmonicField {
     pub iterations: usize,
     /// Solves: the first plus the nested ones for the deep regions (see [`solve_w`]).
     pub solves: usize,
+    /// The nested levels below the first solve.
+    pub nested: LevelStats,
     /// The worst final relative residual of the solves.
     pub relative_residual: f64,
     /// Wall-clock time of the solve.
@@ -100,6 +102,7 @@ impl HarmonicField {
             target: agent.target,
             iterations: solution.iterations,
             solves: solution.solves,
+            nested: solution.nested,
             relative_residual: solution.relative_residual,
             solve_time: started.elapsed(),
         })

@@ -21,6 +21,7 @@
 //! assert!(field.streamline(agent.start).reached);
 //! ```
 
+mod banded;
 pub mod export;
 mod firas;
 mod grid;
@@ -39,6 +40,7 @@ pub use grid::Grid;
 pub use guidance_field::GuidanceField;
 pub use harmonic::{GRADIENT_FLOOR, HarmonicField};
 pub use mask::{CellCounts, Disc, FreeSpace};
+pub use nested::LevelStats;
 pub use sample::Sampler;
 pub use scaled::ScaledW;
 pub use streamline::Streamline;

@@ -30,6 +30,7 @@
 //! accepts changes them by little (in a corridor of width `w`, by about `e^(−2π x / w)` at a
 //! distance `x`).
 
+use super::banded;
 use super::grid::Grid;
 use super::multigrid;
 use super::scaled::{ScaledW, exponent_of, ldexp};
@@ -69,6 +70,9 @@ pub const LEVEL_RANGE: f64 = 1e-12;
 pub const GAP: f64 = 1e3;
 /// CG iterations allowed per solve.
 pub const MAX_ITERATIONS: usize = 500;
+/// The widest band a part may have to be solved directly (`banded.rs`) rather than by
+/// multigrid: a few corridors side by side.
+pub const MAX_BAND: usize = 48;
 
 /// What the nested levels did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -152,6 +156,8 @@ struct Levels<'a> {
     part: Vec<u32>,
     /// Scratch marks for the per-part passes: `seen[k] == stamp`.
     seen: Vec<u32>,
+    /// A part's cell's index in the part (where `seen` marks the part).
+    slot: Vec<u32>,
     stamp: u32,
     level: u32,
     /// The extent of the next band's core, in steps.
@@ -177,6 +183,7 @@ pub fn solve_levels(
         dist: vec![0; n],
         part: vec![0; n],
         seen: vec![0; n],
+        slot: vec![0; n],
         stamp: 0,
         level: 0,
         core_steps: CORE_STEPS,
@@ -372,7 +379,6 @@ impl Levels<'_> {
     /// Dirichlet values and 0 at the cut, at the scale `2^e` of its largest accepted neighbour;
     /// stores every cell of the part at that scale and returns `e`.
     fn solve_part(&mut self, cells: &[usize]) -> i32 {
-        let g = self.grid;
         let scale = cells
             .iter()
             .flat_map(|&k| self.neighbours(k))
@@ -380,6 +386,49 @@ impl Levels<'_> {
             .map(|m| self.w.exponent[m] + exponent_of(self.w.mantissa[m]))
             .max()
             .unwrap_or(0);
+        self.stats.solves += 1;
+        self.stats.cells_solved += cells.len();
+        if !self.solve_narrow(cells, scale) {
+            self.solve_wide(cells, scale);
+        }
+        scale
+    }
+
+    /// Solves a narrow part directly (see `banded.rs`) at the scale `2^scale`; `false` when it
+    /// is too wide for that.
+    fn solve_narrow(&mut self, cells: &[usize], scale: i32) -> bool {
+        self.stamp += 1;
+        let mine = self.stamp;
+        for (index, &k) in cells.iter().enumerate() {
+            self.seen[k] = mine;
+            self.slot[k] = index as u32;
+        }
+        let mut neighbours = Vec::with_capacity(cells.len());
+        let mut rhs = vec![0.0; cells.len()];
+        for (index, &k) in cells.iter().enumerate() {
+            let mut inside = [u32::MAX; 4];
+            for (n, m) in self.neighbours(k).enumerate() {
+                if self.seen[m] == mine {
+                    inside[n] = self.slot[m];
+                } else if self.accepted(m) {
+                    rhs[index] += self.w.at_scale(m, scale);
+                }
+            }
+            neighbours.push(inside);
+        }
+        let Some(u) = banded::solve(&neighbours, &rhs, MAX_BAND) else {
+            return false;
+        };
+        for (&k, u) in cells.iter().zip(u) {
+            self.w.mantissa[k] = u;
+            self.w.exponent[k] = scale;
+        }
+        true
+    }
+
+    /// Solves a wide part by multigrid on its bounding box, at the scale `2^scale`.
+    fn solve_wide(&mut self, cells: &[usize], scale: i32) {
+        let g = self.grid;
         let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
         for &k in cells {
             let (i, j) = (k % g.nx, k / g.nx);
@@ -419,15 +468,12 @@ impl Levels<'_> {
             values[local(k)] = self.w.at_scale(k, scale).clamp(0.0, largest);
         }
         let stats = multigrid::solve(&sub, &unknown, &mut values, self.tolerance, MAX_ITERATIONS);
-        self.stats.solves += 1;
         self.stats.iterations += stats.iterations;
         self.stats.relative_residual = self.stats.relative_residual.max(stats.relative_residual);
-        self.stats.cells_solved += cells.len();
         for &k in cells {
             self.w.mantissa[k] = values[local(k)];
             self.w.exponent[k] = scale;
         }
-        scale
     }
 
     /// The cells of a solved part that are resolved (at least `τ` of the scale `2^e`, or
