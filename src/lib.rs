@@ -15,9 +15,11 @@
 //! - [`record`]: the Rerun recording.
 //! - [`run`](mod@run): a whole headless run, as the `nadf run` command does it.
 //! - [`sweep`]: parameter sweeps in parallel, with a CSV and a plot (`nadf sweep`).
+//! - [`scen`]: Moving AI scenario batches on a map world (`nadf scen`).
 //! - [`cli`]: the `nadf` commands (the binary only parses and dispatches); [`output`]: writing
 //!   files whole or not at all, and checking outputs before a run.
 
+mod chart;
 pub mod cli;
 pub mod control;
 pub mod expect;
@@ -26,6 +28,7 @@ pub mod metrics;
 pub mod output;
 pub mod record;
 pub mod run;
+pub mod scen;
 pub mod sim;
 pub mod sweep;
 pub mod world;

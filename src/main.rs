@@ -4,7 +4,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use nadf::cli::{self, CheckArgs, Console, FieldArgs, RunArgs, SweepArgs};
+use nadf::cli::{self, CheckArgs, Console, FieldArgs, RunArgs, ScenArgs, SweepArgs};
 
 #[derive(Parser)]
 #[command(
@@ -27,6 +27,10 @@ enum Command {
     /// (every summary metric per run and agent) and `sweep.png` (settling time, δ_m and
     /// contacts against the first swept value).
     Sweep(SweepArgs),
+    /// Run a world on a Moving AI map once per scenario of a `.map.scen` file, in parallel, and
+    /// write `scen.csv` (every run's metrics, skipped scenarios with the reason) and `scen.png`
+    /// (success and path / optimal against the optimal length).
+    Scen(ScenArgs),
     /// Validate world files and print every problem found (file, line, key).
     Check(CheckArgs),
 }
@@ -38,6 +42,7 @@ fn main() -> ExitCode {
         Command::Run(args) => cli::run(args, &console),
         Command::Field(args) => cli::field(args),
         Command::Sweep(args) => cli::sweep(args, &console),
+        Command::Scen(args) => cli::scen(args, &console),
         Command::Check(args) => cli::check(args),
     };
     match result {

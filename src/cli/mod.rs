@@ -13,11 +13,13 @@
 mod check;
 mod field;
 mod run;
+mod scen;
 mod sweep;
 
 pub use check::{CheckArgs, check};
 pub use field::{FieldArgs, field};
 pub use run::{RunArgs, run};
+pub use scen::{ScenArgs, scen};
 pub use sweep::{SweepArgs, sweep};
 
 use std::io::IsTerminal;

@@ -4,26 +4,14 @@
 //! `assets/fonts` (no system fonts needed) and encoded as PNG.
 
 use std::collections::BTreeMap;
-use std::sync::Once;
 
 use plotters::prelude::*;
-use plotters::style::{FontStyle, register_font};
 
 use super::Sweep;
+use crate::chart::{PALETTE, padded, register_font};
 
-/// The bundled font (DejaVu Sans; its licence is beside it).
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 /// Picture size, pixels.
 const SIZE: (u32, u32) = (900, 1100);
-/// Line colours, cycled.
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-];
 
 /// One run on a line: the first swept value and the three plotted metrics (settling time,
 /// δ_m, contacts; `None` where the run never settled).
@@ -31,11 +19,7 @@ type Point = (f64, [Option<f64>; 3]);
 
 /// The sweep's plot as PNG bytes, titled `title`.
 pub fn plot(sweep: &Sweep, title: &str) -> Result<Vec<u8>, String> {
-    static FONT_ONCE: Once = Once::new();
-    FONT_ONCE.call_once(|| {
-        // Cannot fail on the bundled file; a failure would show as missing text, not a crash.
-        let _ = register_font("sans-serif", FontStyle::Normal, FONT);
-    });
+    register_font();
     // One series per agent and combination of the other swept values.
     let mut series: BTreeMap<String, Vec<Point>> = BTreeMap::new();
     for (values, summaries) in &sweep.runs {
@@ -148,12 +132,6 @@ fn short(key: &str) -> &str {
         Some((i, _)) => &key[i + 1..],
         None => key,
     }
-}
-
-/// An axis range around `[lo, hi]` with a little room on both sides.
-fn padded(lo: f64, hi: f64) -> (f64, f64) {
-    let span = if hi > lo { hi - lo } else { lo.abs().max(1.0) };
-    (lo - 0.03 * span, hi + 0.03 * span)
 }
 
 #[cfg(test)]
