@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use super::{Failure, bad_input, load};
+use super::{Failure, bad_input, load, write_all};
 use crate::field::{HarmonicField, export};
 use crate::output;
 use crate::record::field_picture;
@@ -100,11 +100,7 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         let (rgb, width, height) = field_picture(&field, agent);
         files.push((png.clone(), export::png(&rgb, width, height)));
     }
-    for (out, bytes) in files {
-        output::write_atomically(&out, &bytes).map_err(|e| bad_input(path, e))?;
-        println!("wrote {}", out.display());
-    }
-    Ok(())
+    write_all(path, files)
 }
 
 /// `10^x` in scientific notation, for any `x` (`3.162e-7000`).

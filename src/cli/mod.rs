@@ -23,7 +23,7 @@ pub use scen::{ScenArgs, scen};
 pub use sweep::{SweepArgs, sweep};
 
 use std::io::IsTerminal;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -111,6 +111,47 @@ fn load(path: &Path, overrides: &[Override]) -> Result<World, Failure> {
         eprintln!("warning: {w}");
     }
     Ok(world)
+}
+
+/// The options every batch of runs takes (`sweep`, `scen`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct BatchArgs {
+    /// Override a world value for every run (see `run`). Repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub overrides: Vec<Override>,
+    /// The directory to write into [default: WORLD_STEM-sweep or WORLD_STEM-scen].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Threads to run on [default: one per core].
+    #[arg(long, short = 'j', value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub jobs: Option<u16>,
+}
+
+impl BatchArgs {
+    /// The directory to write into: `--out`, or `WORLD_STEM-KIND` in the current directory.
+    fn dir(&self, world: &Path, kind: &str) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| {
+            let stem = world
+                .file_stem()
+                .map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned());
+            PathBuf::from(format!("{stem}-{kind}"))
+        })
+    }
+
+    /// The threads asked for.
+    fn threads(&self) -> Option<usize> {
+        self.jobs.map(usize::from)
+    }
+}
+
+/// Writes each file whole (see [`crate::output`]) and says so; a failure is the world's bad
+/// input (its outputs were checked before the work).
+fn write_all(world: &Path, files: Vec<(PathBuf, Vec<u8>)>) -> Result<(), Failure> {
+    for (file, bytes) in files {
+        crate::output::write_atomically(&file, &bytes).map_err(|e| bad_input(world, e))?;
+        println!("wrote {}", file.display());
+    }
+    Ok(())
 }
 
 /// `error: FILE: MESSAGE`, bad input.

@@ -2,11 +2,10 @@
 
 use std::path::PathBuf;
 
-use super::{Console, Failure, bad_input, load};
+use super::{BatchArgs, Console, Failure, bad_input, load, write_all};
 use crate::output;
 use crate::scen;
 use crate::sweep::SweepError;
-use crate::world::Override;
 
 /// The arguments of `nadf scen`.
 #[derive(Debug, Clone, clap::Args)]
@@ -22,29 +21,18 @@ pub struct ScenArgs {
     /// Run only the scenarios of these buckets. Repeatable.
     #[arg(long = "bucket", value_name = "B")]
     pub buckets: Vec<u32>,
-    /// Override a world value for every run (see `run`). Repeatable.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub overrides: Vec<Override>,
-    /// The directory to write into [default: WORLD_STEM-scen].
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
-    /// Threads to run on [default: one per core].
-    #[arg(long, short = 'j', value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
-    pub jobs: Option<u16>,
+    /// The overrides, output directory and threads.
+    #[command(flatten)]
+    pub batch: BatchArgs,
 }
 
 /// Runs the scenarios in parallel with a progress bar and writes `DIR/scen.csv` and
 /// `DIR/scen.png`.
 pub fn scen(args: &ScenArgs, console: &Console) -> Result<(), Failure> {
     let path = &args.world;
-    let dir = args.out.clone().unwrap_or_else(|| {
-        let stem = path
-            .file_stem()
-            .map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned());
-        PathBuf::from(format!("{stem}-scen"))
-    });
+    let dir = args.batch.dir(path, "scen");
     output::check_dir(&dir).map_err(|e| bad_input(path, e))?;
-    let world = load(path, &args.overrides)?;
+    let world = load(path, &args.batch.overrides)?;
     let count = args.count.map(|n| n as usize);
     let entries = scen::entries(&world, &args.scenarios, &args.buckets, count)
         .map_err(|e| bad_input(path, e))?;
@@ -53,8 +41,12 @@ pub fn scen(args: &ScenArgs, console: &Console) -> Result<(), Failure> {
         to_run as u64,
         "{bar:40} {pos}/{len} scenarios, {elapsed} (eta {eta})",
     );
-    let jobs = args.jobs.map(usize::from);
-    let result = scen::run_all(&entries, jobs, &|| bar.inc(1), Some(&console.interrupt));
+    let result = scen::run_all(
+        &entries,
+        args.batch.threads(),
+        &|| bar.inc(1),
+        Some(&console.interrupt),
+    );
     bar.finish_and_clear();
     let outcomes = match result {
         Ok(outcomes) => outcomes,
@@ -68,14 +60,13 @@ pub fn scen(args: &ScenArgs, console: &Console) -> Result<(), Failure> {
         scen::plot(&outcomes, &title).map_err(|e| bad_input(path, format!("cannot draw: {e}")))?;
     std::fs::create_dir_all(&dir)
         .map_err(|e| bad_input(path, format!("cannot create {}: {e}", dir.display())))?;
-    for (name, bytes) in [
-        ("scen.csv", scen::csv(&outcomes).into_bytes()),
-        ("scen.png", picture),
-    ] {
-        let file = dir.join(name);
-        output::write_atomically(&file, &bytes).map_err(|e| bad_input(path, e))?;
-        println!("wrote {}", file.display());
-    }
+    write_all(
+        path,
+        vec![
+            (dir.join("scen.csv"), scen::csv(&outcomes).into_bytes()),
+            (dir.join("scen.png"), picture),
+        ],
+    )?;
     for o in outcomes.iter().filter(|o| o.summary.is_err()) {
         if let Err(why) = &o.summary {
             println!("skipped line {}: {why}", o.scenario.line);

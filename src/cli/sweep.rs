@@ -2,10 +2,9 @@
 
 use std::path::PathBuf;
 
-use super::{Console, Failure, bad_input};
+use super::{BatchArgs, Console, Failure, bad_input, write_all};
 use crate::output;
 use crate::sweep::{self, Range, SweepError};
-use crate::world::Override;
 
 /// The arguments of `nadf sweep`.
 #[derive(Debug, Clone, clap::Args)]
@@ -21,25 +20,19 @@ pub struct SweepArgs {
         required = true
     )]
     pub ranges: Vec<Range>,
-    /// Override a world value for every run (see `run`). Repeatable.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub overrides: Vec<Override>,
-    /// The directory to write into [default: WORLD_STEM-sweep].
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
-    /// Threads to run on [default: one per core].
-    #[arg(long, short = 'j', value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
-    pub jobs: Option<u16>,
+    /// The overrides, output directory and threads.
+    #[command(flatten)]
+    pub batch: BatchArgs,
 }
 
 /// Loads every combination, runs them in parallel with a progress bar, and writes
 /// `DIR/sweep.csv` and `DIR/sweep.png`.
 pub fn sweep(args: &SweepArgs, console: &Console) -> Result<(), Failure> {
     let path = &args.world;
-    let dir = args.out.clone().unwrap_or_else(|| sweep::default_out(path));
+    let dir = args.batch.dir(path, "sweep");
     output::check_dir(&dir).map_err(|e| bad_input(path, e))?;
     let (file, cases) =
-        sweep::cases(path, &args.ranges, &args.overrides).map_err(|e| bad_input(path, e))?;
+        sweep::cases(path, &args.ranges, &args.batch.overrides).map_err(|e| bad_input(path, e))?;
     if let Some(first) = cases.first() {
         for w in file.warnings(&first.world) {
             eprintln!("warning: {w}");
@@ -50,7 +43,7 @@ pub fn sweep(args: &SweepArgs, console: &Console) -> Result<(), Failure> {
         cases.len() as u64,
         "{bar:40} {pos}/{len} runs, {elapsed} (eta {eta})",
     );
-    let jobs = args.jobs.map(usize::from);
+    let jobs = args.batch.threads();
     let result = sweep::run_all(
         &keys,
         &cases,
@@ -71,14 +64,13 @@ pub fn sweep(args: &SweepArgs, console: &Console) -> Result<(), Failure> {
         .map_err(|e| bad_input(path, format!("cannot draw the sweep's plot: {e}")))?;
     std::fs::create_dir_all(&dir)
         .map_err(|e| bad_input(path, format!("cannot create {}: {e}", dir.display())))?;
-    for (name, bytes) in [
-        ("sweep.csv", done.csv().into_bytes()),
-        ("sweep.png", picture),
-    ] {
-        let file = dir.join(name);
-        output::write_atomically(&file, &bytes).map_err(|e| bad_input(path, e))?;
-        println!("wrote {}", file.display());
-    }
+    write_all(
+        path,
+        vec![
+            (dir.join("sweep.csv"), done.csv().into_bytes()),
+            (dir.join("sweep.png"), picture),
+        ],
+    )?;
     println!(
         "{} runs on {} thread(s) in {:.2} s",
         done.runs.len(),

@@ -80,6 +80,21 @@ impl Grid {
         .filter(move |&(a, b)| a < nx && b < ny)
     }
 
+    /// The 4-neighbours of the cell of linear index `k` that are on the grid, as linear indices.
+    pub fn neighbours_of(&self, k: usize) -> impl Iterator<Item = usize> + use<> {
+        let (nx, ny) = (self.nx, self.ny);
+        let (i, j) = (k % nx, k / nx);
+        [
+            (i.wrapping_sub(1), j),
+            (i + 1, j),
+            (i, j.wrapping_sub(1)),
+            (i, j + 1),
+        ]
+        .into_iter()
+        .filter(move |&(a, b)| a < nx && b < ny)
+        .map(move |(a, b)| b * nx + a)
+    }
+
     /// Centre of cell `(i, j)`, m.
     pub fn center(&self, i: usize, j: usize) -> [f64; 2] {
         [

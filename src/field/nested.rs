@@ -202,25 +202,10 @@ pub fn solve_levels(
     levels.stats
 }
 
-/// The 4-neighbours of cell `k` of `g`, as indices.
-fn around(g: Grid, k: usize) -> impl Iterator<Item = usize> {
-    let (nx, ny) = (g.nx, g.ny);
-    let (i, j) = (k % nx, k / nx);
-    [
-        (i.wrapping_sub(1), j),
-        (i + 1, j),
-        (i, j.wrapping_sub(1)),
-        (i, j + 1),
-    ]
-    .into_iter()
-    .filter(move |&(a, b)| a < nx && b < ny)
-    .map(move |(a, b)| b * nx + a)
-}
-
 impl Levels<'_> {
     /// The 4-neighbours of cell `k`, as indices.
     fn neighbours(&self, k: usize) -> impl Iterator<Item = usize> + use<> {
-        around(*self.grid, k)
+        self.grid.neighbours_of(k)
     }
 
     fn in_band(&self, k: usize) -> bool {
@@ -577,7 +562,7 @@ mod tests {
         let mut seen = vec![false; grid.len()];
         seen[path[0]] = true;
         while let Some(&k) = path.last() {
-            let Some(next) = around(grid, k).find(|&m| reachable[m] && !seen[m]) else {
+            let Some(next) = grid.neighbours_of(k).find(|&m| reachable[m] && !seen[m]) else {
                 break;
             };
             seen[next] = true;
@@ -596,8 +581,8 @@ mod tests {
             let (a, b) = (pair[0], pair[1]);
             let ratio = (w.log2(b) - w.log2(a)).exp2();
             let straight = a / grid.nx == b / grid.nx
-                && around(grid, a).filter(|&m| reachable[m]).count() == 2
-                && around(grid, b).filter(|&m| reachable[m]).count() == 2;
+                && grid.neighbours_of(a).filter(|&m| reachable[m]).count() == 2
+                && grid.neighbours_of(b).filter(|&m| reachable[m]).count() == 2;
             if straight && (a % grid.nx) > 3 && (a % grid.nx) < n - 4 {
                 assert!((ratio / expected - 1.0).abs() < 5e-6, "{ratio} at cell {a}");
             }
@@ -605,7 +590,7 @@ mod tests {
         // Harmonic at every cell beyond the first solve's, to relative precision.
         for &k in &path[30..] {
             let e = w.exponent[k];
-            let sum: f64 = around(grid, k).map(|m| w.at_scale(m, e)).sum();
+            let sum: f64 = grid.neighbours_of(k).map(|m| w.at_scale(m, e)).sum();
             let own = w.mantissa[k];
             assert!((4.0 * own - sum).abs() <= 1e-6 * 4.0 * own, "cell {k}");
         }

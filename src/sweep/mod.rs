@@ -10,7 +10,7 @@
 
 mod plot;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::str::FromStr;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -304,14 +304,6 @@ impl Sweep {
             .collect();
         metrics::csv(&keys, &rows)
     }
-}
-
-/// Where `nadf sweep` writes by default: `STEM-sweep/` beside the current directory.
-pub fn default_out(world: &Path) -> PathBuf {
-    let stem = world
-        .file_stem()
-        .map_or_else(|| "world".into(), |s| s.to_string_lossy().into_owned());
-    PathBuf::from(format!("{stem}-sweep"))
 }
 
 #[cfg(test)]
