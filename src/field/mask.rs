@@ -20,13 +20,13 @@ pub struct Disc {
 impl Disc {
     /// The disc as a wall shape, for rasterizing.
     pub fn shape(&self) -> WallShape {
-        WallShape {
-            pose: parry2d::math::Pose::from_translation(parry2d::math::Vector::new(
+        WallShape::new(
+            parry2d::math::Pose::from_translation(parry2d::math::Vector::new(
                 self.center[0] as f32,
                 self.center[1] as f32,
             )),
-            shape: parry2d::shape::SharedShape::ball(self.radius as f32),
-        }
+            parry2d::shape::SharedShape::ball(self.radius as f32),
+        )
     }
 }
 

@@ -183,9 +183,16 @@ fn others_than(discs: &[Disc], index: usize) -> Vec<Disc> {
 /// Signed distance from a disc of `radius` at `position` to the nearest wall, m: positive when
 /// clear, negative by the overlap depth when the disc is inside a wall.
 pub fn signed_clearance(walls: &[WallShape], position: Vector2<f64>, radius: f64) -> f64 {
-    walls
-        .iter()
-        .map(|w| w.signed_distance_to_point(position.x, position.y))
-        .fold(f64::INFINITY, f64::min)
-        - radius
+    let (x, y) = (position.x, position.y);
+    // Walls whose bounding box is farther than the nearest wall so far cannot be nearer: a
+    // map's thousands of walls cost a box test each, not a distance query.
+    let mut nearest = f64::INFINITY;
+    for w in walls {
+        let bound = w.distance_bound(x, y);
+        // (Inside a box the wall may hold the point deeper than any other: always measured.)
+        if bound < nearest || bound <= 0.0 {
+            nearest = nearest.min(w.signed_distance_to_point(x, y));
+        }
+    }
+    nearest - radius
 }

@@ -14,9 +14,37 @@ pub struct WallShape {
     pub pose: Pose,
     /// The shape in its local frame.
     pub shape: SharedShape,
+    /// Its bounding box in the world, `[x0, y0, x1, y1]`, m: a cheap lower bound of the
+    /// distance to it (a map has thousands of walls, and the clearance is measured every step).
+    bounds: [f64; 4],
 }
 
 impl WallShape {
+    /// The wall of `shape` at `pose`.
+    pub fn new(pose: Pose, shape: SharedShape) -> Self {
+        let aabb = shape.compute_aabb(&pose);
+        let bounds = [
+            f64::from(aabb.mins.x),
+            f64::from(aabb.mins.y),
+            f64::from(aabb.maxs.x),
+            f64::from(aabb.maxs.y),
+        ];
+        Self {
+            pose,
+            shape,
+            bounds,
+        }
+    }
+
+    /// A lower bound of the distance from `(x, y)` to the wall (from its bounding box), m.
+    pub fn distance_bound(&self, x: f64, y: f64) -> f64 {
+        let [x0, y0, x1, y1] = self.bounds;
+        let dx = (x0 - x).max(x - x1).max(0.0);
+        let dy = (y0 - y).max(y - y1).max(0.0);
+        // Less a margin for the f32 rounding of the box and of parry's distance.
+        dx.hypot(dy) - 1e-4
+    }
+
     /// Distance from a point to the wall, m (0 inside it).
     pub fn distance_to_point(&self, x: f64, y: f64) -> f64 {
         f64::from(
@@ -60,22 +88,22 @@ pub fn wall_shape(wall: &Wall) -> Option<WallShape> {
             center,
             half_extents,
             angle,
-        } => WallShape {
-            pose: Pose::new(v(*center), *angle as f32),
-            shape: SharedShape::cuboid(half_extents[0] as f32, half_extents[1] as f32),
-        },
-        Wall::Segment { a, b, thickness } => WallShape {
-            pose: Pose::IDENTITY,
-            shape: SharedShape::capsule(v(*a), v(*b), (*thickness / 2.0) as f32),
-        },
-        Wall::Disc { center, radius } => WallShape {
-            pose: Pose::from_translation(v(*center)),
-            shape: SharedShape::ball(*radius as f32),
-        },
-        Wall::Polygon { points } => WallShape {
-            pose: Pose::IDENTITY,
-            shape: SharedShape::convex_polyline(points.iter().map(|p| v(*p)).collect())?,
-        },
+        } => WallShape::new(
+            Pose::new(v(*center), *angle as f32),
+            SharedShape::cuboid(half_extents[0] as f32, half_extents[1] as f32),
+        ),
+        Wall::Segment { a, b, thickness } => WallShape::new(
+            Pose::IDENTITY,
+            SharedShape::capsule(v(*a), v(*b), (*thickness / 2.0) as f32),
+        ),
+        Wall::Disc { center, radius } => WallShape::new(
+            Pose::from_translation(v(*center)),
+            SharedShape::ball(*radius as f32),
+        ),
+        Wall::Polygon { points } => WallShape::new(
+            Pose::IDENTITY,
+            SharedShape::convex_polyline(points.iter().map(|p| v(*p)).collect())?,
+        ),
     })
 }
 
