@@ -27,6 +27,10 @@ impl Stencil {
     }
 }
 
+/// How many cells beyond the interpolation stencil a point off the field looks for a reachable
+/// cell to take its guidance from.
+const NEAR: i64 = 3;
+
 /// `W` and its central-difference gradient at every cell centre, ready for interpolation.
 #[derive(Debug, Clone)]
 pub struct Sampler {
@@ -106,6 +110,24 @@ impl Sampler {
             // Exactly on a centre line with the other cells blocked: the cell itself.
             let k = g.index(i, j);
             if self.reachable[k] {
+                out.push(k, 1.0);
+            }
+        }
+        if out.len == 0 {
+            // A body pressed into the blocked band along a wall (a hard contact at speed) is
+            // off the field: it takes the nearest reachable cell within NEAR cells, whose
+            // guidance leads it back out. Farther off the field there is none.
+            let nearest = (i0 as i64 - NEAR..=i0 as i64 + 1 + NEAR)
+                .flat_map(|i| (j0 as i64 - NEAR..=j0 as i64 + 1 + NEAR).map(move |j| (i, j)))
+                .filter(|&(i, j)| i >= 0 && j >= 0 && i < g.nx as i64 && j < g.ny as i64)
+                .map(|(i, j)| g.index(i as usize, j as usize))
+                .filter(|&k| self.reachable[k])
+                .map(|k| {
+                    let [x, y] = g.center(k % g.nx, k / g.nx);
+                    ((x - p[0]).hypot(y - p[1]), k)
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            if let Some((_, k)) = nearest {
                 out.push(k, 1.0);
             }
         }
@@ -213,7 +235,9 @@ mod tests {
             }
         }
         let s = Sampler::new(grid, ScaledW::from_plain(vec![0.5; grid.len()]), reachable);
-        assert!(s.w([0.15, 0.15]).is_none());
+        // Within three cells of a reachable one: its value (a body pushed into a wall's band).
+        assert_eq!(s.w([0.15, 0.15]), Some(0.5));
+        assert!(s.w([-0.45, -0.45]).is_none());
         assert!(s.grad_w([f64::NAN, 0.5]).is_none());
         assert!(s.w([0.8, 0.8]).is_some());
     }
