@@ -252,7 +252,7 @@ fn parse(text: &str, file: &Path) -> Result<World, Vec<Problem>> {
         if !given("origin") {
             world.origin = occupancy.origin;
         }
-        let walls = occupancy.rectangles();
+        let walls = map::rectangles(&occupancy);
         world.loaded_map = Some(Arc::new(LoadedMap { occupancy, walls }));
     } else if !given("size") {
         return Err(vec![Problem {

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-use super::map::Occupancy;
+use super::map::occupancy::Occupancy;
 
 /// A whole world: the box, its walls, its agents and how long to simulate them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -8,6 +8,7 @@
 
 mod maze;
 mod movingai;
+pub(crate) mod occupancy;
 mod ros;
 
 use std::collections::BTreeMap;
@@ -15,38 +16,9 @@ use std::path::{Path, PathBuf};
 
 pub use maze::perfect_maze;
 pub use movingai::{Scenario, read_scenarios};
+pub use occupancy::{CellState, Occupancy};
 
 use super::schema::{MapSettings, UnknownCells, Wall};
-
-/// What a map says of one cell.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CellState {
-    /// Passable.
-    Free,
-    /// Occupied: a wall.
-    Blocked,
-    /// Not known (ROS maps): blocked or free as the world's `[map] unknown` says.
-    Unknown,
-}
-
-/// A map read from its file, y-up.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Occupancy {
-    /// The file it was read from.
-    pub file: PathBuf,
-    /// Cells along x.
-    pub width: usize,
-    /// Cells along y.
-    pub height: usize,
-    /// Cell size, m.
-    pub cell: f64,
-    /// The lower-left corner of cell (0, 0), m.
-    pub origin: [f64; 2],
-    /// The cells, row by row from the bottom: `cells[j * width + i]`.
-    pub cells: Vec<CellState>,
-    /// Whether unknown cells are walls.
-    pub unknown_blocked: bool,
-}
 
 /// A map file that cannot be read: the file, the line (and column) when known, and what.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -99,97 +71,44 @@ pub fn read(settings: &MapSettings, base: &Path) -> Result<Occupancy, MapError> 
     Ok(map)
 }
 
-impl Occupancy {
-    /// The map's width and height, m.
-    pub fn extent(&self) -> [f64; 2] {
-        [
-            self.width as f64 * self.cell,
-            self.height as f64 * self.cell,
-        ]
-    }
-
-    /// Whether cell `(i, j)` is a wall (unknown cells as the settings say).
-    pub fn blocked(&self, i: usize, j: usize) -> bool {
-        match self.cells[j * self.width + i] {
-            CellState::Blocked => true,
-            CellState::Unknown => self.unknown_blocked,
-            CellState::Free => false,
+/// The blocked cells of `map` as boxes: each row's runs of blocked cells, merged with the same run
+/// of the rows above while it continues. Exactly the blocked cells, no more (every cell of
+/// a box is blocked) and no less (every blocked cell is in one box).
+pub fn rectangles(map: &Occupancy) -> Vec<Wall> {
+    // Open boxes: their first row, keyed by their columns `[i0, i1)` (ordered, so the walls
+    // come out in the same order every time).
+    let mut open: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+    let mut walls = Vec::new();
+    for j in 0..=map.height {
+        let runs = if j < map.height {
+            map.runs(j)
+        } else {
+            Vec::new()
+        };
+        let mut next = BTreeMap::new();
+        for run in runs {
+            next.insert(run, open.remove(&run).unwrap_or(j));
+        }
+        for ((i0, i1), j0) in std::mem::replace(&mut open, next) {
+            walls.push(cells_box(map, [i0, i1], [j0, j]));
         }
     }
+    walls
+}
 
-    /// The centre of cell `(i, j)`, m.
-    pub fn center(&self, i: usize, j: usize) -> [f64; 2] {
-        [
-            self.origin[0] + (i as f64 + 0.5) * self.cell,
-            self.origin[1] + (j as f64 + 0.5) * self.cell,
-        ]
-    }
-
-    /// The cell containing `p`, if it is on the map.
-    pub fn cell_of(&self, p: [f64; 2]) -> Option<(usize, usize)> {
-        let fx = (p[0] - self.origin[0]) / self.cell;
-        let fy = (p[1] - self.origin[1]) / self.cell;
-        (fx >= 0.0 && fy >= 0.0 && (fx as usize) < self.width && (fy as usize) < self.height)
-            .then_some((fx as usize, fy as usize))
-    }
-
-    /// The blocked cells as boxes: each row's runs of blocked cells, merged with the same run
-    /// of the rows above while it continues. Exactly the blocked cells, no more (every cell of
-    /// a box is blocked) and no less (every blocked cell is in one box).
-    pub fn rectangles(&self) -> Vec<Wall> {
-        // Open boxes: their first row, keyed by their columns `[i0, i1)` (ordered, so the walls
-        // come out in the same order every time).
-        let mut open: BTreeMap<(usize, usize), usize> = BTreeMap::new();
-        let mut walls = Vec::new();
-        for j in 0..=self.height {
-            let runs = if j < self.height {
-                self.runs(j)
-            } else {
-                Vec::new()
-            };
-            let mut next = BTreeMap::new();
-            for run in runs {
-                next.insert(run, open.remove(&run).unwrap_or(j));
-            }
-            for ((i0, i1), j0) in std::mem::replace(&mut open, next) {
-                walls.push(self.cells_box([i0, i1], [j0, j]));
-            }
-        }
-        walls
-    }
-
-    /// The box covering the cells `[i0, i1) × [j0, j1)`.
-    fn cells_box(&self, [i0, i1]: [usize; 2], [j0, j1]: [usize; 2]) -> Wall {
-        let half = [
-            0.5 * (i1 - i0) as f64 * self.cell,
-            0.5 * (j1 - j0) as f64 * self.cell,
-        ];
-        Wall::Box {
-            center: [
-                self.origin[0] + i0 as f64 * self.cell + half[0],
-                self.origin[1] + j0 as f64 * self.cell + half[1],
-            ],
-            half_extents: half,
-            angle: 0.0,
-        }
-    }
-
-    /// The runs `[i0, i1)` of blocked cells in row `j`.
-    fn runs(&self, j: usize) -> Vec<(usize, usize)> {
-        let mut runs = Vec::new();
-        let mut start = None;
-        for i in 0..=self.width {
-            let blocked = i < self.width && self.blocked(i, j);
-            match (blocked, start) {
-                (true, None) => start = Some(i),
-                (false, Some(s)) => {
-                    runs.push((s, i));
-                    start = None;
-                }
-                _ => {}
-            }
-        }
-        runs
+/// The box covering the cells `[i0, i1) × [j0, j1)`.
+fn cells_box(map: &Occupancy, [i0, i1]: [usize; 2], [j0, j1]: [usize; 2]) -> Wall {
+    let half = [
+        0.5 * (i1 - i0) as f64 * map.cell,
+        0.5 * (j1 - j0) as f64 * map.cell,
+    ];
+    Wall::Box {
+        center: [
+            map.origin[0] + i0 as f64 * map.cell + half[0],
+            map.origin[1] + j0 as f64 * map.cell + half[1],
+        ],
+        half_extents: half,
+        angle: 0.0,
     }
 }
 
@@ -229,7 +148,7 @@ mod tests {
             "@.@@..", //
             "@@@@@@",
         ]);
-        let boxes = m.rectangles();
+        let boxes = rectangles(&m);
         let shapes: Vec<_> = boxes
             .iter()
             .map(|w| crate::world::wall_shape(w).unwrap())
