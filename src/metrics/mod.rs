@@ -238,11 +238,7 @@ impl Metrics {
     /// The summary, with `δ_m` measured against `kinematic`.
     pub fn summary(&self, kinematic: &Streamline, faults: &Faults) -> Summary {
         let reached = self.final_distance <= self.band;
-        let max_deviation = self
-            .path
-            .iter()
-            .map(|p| kinematic.distance_to(*p))
-            .fold(0.0, f64::max);
+        let max_deviation = kinematic.max_distance(&self.path);
         Summary {
             name: self.name.clone(),
             reached,

@@ -21,7 +21,7 @@ use rapier2d::prelude::{ColliderHandle, PhysicsWorld, RigidBodyHandle};
 
 use super::faults::{FaultMonitor, Observation};
 use super::physics::{self, from_rapier, to_rapier};
-use super::{CONTACT_TOLERANCE, Sensor, signed_clearance};
+use super::{CONTACT_TOLERANCE, Sensor, WallIndex};
 use crate::control::{ControlInput, ControlOutput, Controller, unit};
 use crate::field::{Disc, FieldError, GuidanceField, HarmonicField, Streamline};
 use crate::metrics::{Metrics, Summary};
@@ -260,7 +260,7 @@ impl AgentRun {
         &mut self,
         physics: &PhysicsWorld,
         time: f64,
-        walls: &[WallShape],
+        (walls, index): (&[WallShape], &WallIndex),
         bounds: ([f64; 2], [f64; 2]),
     ) -> AgentState {
         let (position, velocity) = self.read_state(physics);
@@ -270,7 +270,7 @@ impl AgentRun {
             .gradient(p)
             .and_then(|g| unit(&g))
             .map_or(0.0, |u| -u.dot(&velocity));
-        let signed = signed_clearance(walls, position, self.agent.radius);
+        let signed = index.signed_clearance(walls, position, self.agent.radius);
         let clearance = signed.max(0.0);
         let faults = self.faults.observe(&Observation {
             field: &self.field,

@@ -16,16 +16,17 @@
 //! sensed walls cut the agent off) keeps the last field and logs a note once.
 
 mod agent;
+mod clearance;
 pub mod faults;
 pub mod pendulum;
 mod physics;
 mod sensor;
 
-use nalgebra::Vector2;
 use rapier2d::prelude::PhysicsWorld;
 use rayon::prelude::*;
 
 pub use agent::{AgentRun, AgentState};
+pub use clearance::{WallIndex, signed_clearance};
 pub use physics::{from_rapier, to_rapier};
 pub use sensor::Sensor;
 
@@ -58,6 +59,8 @@ pub struct Simulation {
     pub world: World,
     /// The walls' shapes, in the order of their colliders.
     pub walls: Vec<WallShape>,
+    /// The walls by bucket, for the clearance after every step.
+    index: WallIndex,
     /// The agents.
     pub agents: Vec<AgentRun>,
     /// The pendulums.
@@ -107,6 +110,7 @@ impl Simulation {
             .collect();
         Ok(Self {
             world: world.clone(),
+            index: WallIndex::new(&walls),
             walls,
             agents,
             pendulums,
@@ -150,7 +154,8 @@ impl Simulation {
         for p in &mut self.pendulums {
             p.observe(&self.physics, self.time);
         }
-        let (walls, bounds) = (&self.walls, self.world.bounds());
+        let walls = (self.walls.as_slice(), &self.index);
+        let bounds = self.world.bounds();
         (self.agents.iter_mut())
             .map(|a| a.observe(&self.physics, self.time, walls, bounds))
             .collect()
@@ -178,21 +183,4 @@ fn others_than(discs: &[Disc], index: usize) -> Vec<Disc> {
         .filter(|&(i, _)| i != index)
         .map(|(_, d)| *d)
         .collect()
-}
-
-/// Signed distance from a disc of `radius` at `position` to the nearest wall, m: positive when
-/// clear, negative by the overlap depth when the disc is inside a wall.
-pub fn signed_clearance(walls: &[WallShape], position: Vector2<f64>, radius: f64) -> f64 {
-    let (x, y) = (position.x, position.y);
-    // Walls whose bounding box is farther than the nearest wall so far cannot be nearer: a
-    // map's thousands of walls cost a box test each, not a distance query.
-    let mut nearest = f64::INFINITY;
-    for w in walls {
-        let bound = w.distance_bound(x, y);
-        // (Inside a box the wall may hold the point deeper than any other: always measured.)
-        if bound < nearest || bound <= 0.0 {
-            nearest = nearest.min(w.signed_distance_to_point(x, y));
-        }
-    }
-    nearest - radius
 }

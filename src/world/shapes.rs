@@ -36,6 +36,11 @@ impl WallShape {
         }
     }
 
+    /// Its bounding box, `[x0, y0, x1, y1]`, m.
+    pub fn bounds(&self) -> [f64; 4] {
+        self.bounds
+    }
+
     /// A lower bound of the distance from `(x, y)` to the wall (from its bounding box), m.
     pub fn distance_bound(&self, x: f64, y: f64) -> f64 {
         let [x0, y0, x1, y1] = self.bounds;
