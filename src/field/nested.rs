@@ -6,18 +6,21 @@
 //! (those with `W ≥ τ`, and those a few steps from them, see [`deep_cells`]); the others are
 //! *pending*, their values only estimates. Each level then:
 //!
-//! 1. takes a **band** of pending cells next to the accepted ones: the *core*, every pending
-//!    cell within [`CORE_STEPS`] of an accepted cell or reached through cells whose estimate is
-//!    still reliable (at least [`BAND`] of the scale of the solve that gave it), and a
-//!    *margin* of [`MARGIN`] more layers;
-//! 2. solves each connected part of the band on its own bounding box, with the accepted cells
-//!    around it as Dirichlet values, scaled so that the largest is about 1, and `W = 0` at the
-//!    *cut* (the pending cells beyond the band): a lower bound of the true `W`, exact at the
-//!    accepted cells and close to it away from the cut;
-//! 3. accepts the cells of the part that the solve resolves (at least `τ` of its scale, or a
-//!    few steps from such a cell), that are more than [`MARGIN`] steps from the cut and at
-//!    least [`GAP`] times the values near it, stored with the exponent of the part's scale
-//!    ([`ScaledW`]).
+//! 1. takes a **band** of pending cells next to the accepted cells whose `W` is within
+//!    [`LEVEL_RANGE`] of the largest such (so cells are accepted in order of decreasing `W`,
+//!    and no cut lies where a larger `W` still flows in): the *core*, every pending cell within
+//!    a number of steps that adapts (from [`CORE_STEPS`]) or reached through cells whose
+//!    estimate is still reliable (at least [`BAND`] of the scale of the solve that gave it);
+//!    a *margin* of [`MARGIN`] more layers; and every pending cell left when they fit in as
+//!    many cells again (a room's deep corner: then there is no cut);
+//! 2. solves each connected part of the band, with the accepted cells around it as Dirichlet
+//!    values, scaled so that the largest is about 1, and `W = 0` at the *cut* (the pending
+//!    cells beyond the band): a lower bound of the true `W`, exact at the accepted cells and
+//!    close to it away from the cut. A narrow part (a stretch of corridor) is solved directly
+//!    (`banded.rs`, accurate cell by cell), a wide one by multigrid on its bounding box;
+//! 3. accepts the cells of the part that the solve resolves (at least `τ` of its scale), that
+//!    are more than [`MARGIN`] steps from the cut and at least [`GAP`] times the values near it,
+//!    stored with the exponent of the part's scale ([`ScaledW`]).
 //!
 //! Every level accepts at least the cells next to the largest accepted neighbour, so the
 //! levels end when every reachable cell is accepted. A cell is solved in about
@@ -461,10 +464,9 @@ impl Levels<'_> {
         }
     }
 
-    /// The cells of a solved part that are resolved (at least `τ` of the scale `2^e`, or
-    /// within [`REACH`] steps of such a cell or of an accepted cell as large) and more than
-    /// [`MARGIN`] steps from the cut, and at least [`GAP`] times the values near the cut and
-    /// the level's `lowest` source (`log2 W`); and whether the cut kept resolved cells out.
+    /// The cells of a solved part that are resolved (at least `τ` of the scale `2^e`), more
+    /// than [`MARGIN`] steps from the cut, and at least [`GAP`] times the values near the cut
+    /// and the level's `lowest` source (`log2 W`); and whether the cut kept resolved cells out.
     fn resolved(&mut self, cells: &[usize], e: i32, lowest: f64) -> (Vec<usize>, bool) {
         // Steps from the cut, up to MARGIN: `seen == stamp` marks the cells near it.
         self.stamp += 1;
