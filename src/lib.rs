@@ -19,6 +19,7 @@
 //! - [`cli`]: the `nadf` commands (the binary only parses and dispatches); [`output`]: writing
 //!   files whole or not at all, and checking outputs before a run.
 
+mod buckets;
 mod chart;
 pub mod cli;
 pub mod control;

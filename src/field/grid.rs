@@ -68,7 +68,7 @@ impl Grid {
     }
 
     /// The 4-neighbours of cell `(i, j)` that are on the grid.
-    pub fn neighbours(&self, i: usize, j: usize) -> impl Iterator<Item = (usize, usize)> {
+    pub fn neighbours(&self, i: usize, j: usize) -> impl Iterator<Item = (usize, usize)> + use<> {
         let (nx, ny) = (self.nx, self.ny);
         [
             (i.wrapping_sub(1), j),
@@ -82,17 +82,9 @@ impl Grid {
 
     /// The 4-neighbours of the cell of linear index `k` that are on the grid, as linear indices.
     pub fn neighbours_of(&self, k: usize) -> impl Iterator<Item = usize> + use<> {
-        let (nx, ny) = (self.nx, self.ny);
-        let (i, j) = (k % nx, k / nx);
-        [
-            (i.wrapping_sub(1), j),
-            (i + 1, j),
-            (i, j.wrapping_sub(1)),
-            (i, j + 1),
-        ]
-        .into_iter()
-        .filter(move |&(a, b)| a < nx && b < ny)
-        .map(move |(a, b)| b * nx + a)
+        let nx = self.nx;
+        self.neighbours(k % nx, k / nx)
+            .map(move |(a, b)| b * nx + a)
     }
 
     /// Centre of cell `(i, j)`, m.

@@ -4,6 +4,7 @@
 use nalgebra::Vector2;
 
 use super::sample::Sampler;
+use crate::buckets::Buckets;
 
 /// A polyline from the start towards the target.
 #[derive(Debug, Clone, PartialEq)]
@@ -101,11 +102,38 @@ impl Streamline {
                 .map(|p| self.distance_to(*p))
                 .fold(0.0, f64::max);
         }
-        let index = SegmentIndex::new(self);
+        let Some(buckets) = self.segment_buckets() else {
+            return points
+                .iter()
+                .map(|p| self.distance_to(*p))
+                .fold(0.0, f64::max);
+        };
         points
             .iter()
-            .map(|p| index.distance(self, Vector2::from(*p)))
+            .map(|p| {
+                let q = Vector2::from(*p);
+                buckets.nearest(*p, |s, best| best.min(self.segment_distance(s, q)))
+            })
             .fold(0.0, f64::max)
+    }
+
+    /// The segments in buckets of about four steps of the path.
+    fn segment_buckets(&self) -> Option<Buckets> {
+        let boxes: Vec<[f64; 4]> = self
+            .points
+            .windows(2)
+            .map(|s| {
+                let [a, b] = [s[0], s[1]];
+                [
+                    a[0].min(b[0]),
+                    a[1].min(b[1]),
+                    a[0].max(b[0]),
+                    a[1].max(b[1]),
+                ]
+            })
+            .collect();
+        let size = self.length() / boxes.len() as f64 * 4.0;
+        Buckets::new(&boxes, size.max(1e-9))
     }
 
     /// Distance from `p` to segment `s` (from point `s` to point `s + 1`), m.
@@ -125,87 +153,6 @@ impl Streamline {
             .windows(2)
             .map(|s| (s[1][0] - s[0][0]).hypot(s[1][1] - s[0][1]))
             .sum()
-    }
-}
-
-/// A polyline's segments by bucket of a grid over its bounding box.
-struct SegmentIndex {
-    origin: [f64; 2],
-    size: f64,
-    nx: usize,
-    ny: usize,
-    buckets: Vec<Vec<u32>>,
-}
-
-impl SegmentIndex {
-    fn new(line: &Streamline) -> Self {
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for p in &line.points {
-            lo = [lo[0].min(p[0]), lo[1].min(p[1])];
-            hi = [hi[0].max(p[0]), hi[1].max(p[1])];
-        }
-        let segments = line.points.len() - 1;
-        let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1e-9);
-        // About a few segments a bucket along the line, whatever its shape.
-        let size = (line.length() / segments as f64 * 4.0).max(extent / 4096.0);
-        let nx = ((hi[0] - lo[0]) / size).floor() as usize + 1;
-        let ny = ((hi[1] - lo[1]) / size).floor() as usize + 1;
-        let mut index = Self {
-            origin: lo,
-            size,
-            nx,
-            ny,
-            buckets: vec![Vec::new(); nx * ny],
-        };
-        for s in 0..segments {
-            let [a, b] = [line.points[s], line.points[s + 1]];
-            let (i0, j0) = index.bucket_of([a[0].min(b[0]), a[1].min(b[1])]);
-            let (i1, j1) = index.bucket_of([a[0].max(b[0]), a[1].max(b[1])]);
-            for j in j0..=j1 {
-                for i in i0..=i1 {
-                    index.buckets[j * nx + i].push(s as u32);
-                }
-            }
-        }
-        index
-    }
-
-    /// The bucket holding `p`, clamped to the grid.
-    fn bucket_of(&self, p: [f64; 2]) -> (usize, usize) {
-        let f =
-            |v: f64, o: f64, n: usize| (((v - o) / self.size).floor().max(0.0) as usize).min(n - 1);
-        (
-            f(p[0], self.origin[0], self.nx),
-            f(p[1], self.origin[1], self.ny),
-        )
-    }
-
-    /// [`Streamline::distance_to`] `p`, searching the buckets ring by ring from the one nearest
-    /// `p` until no farther one can hold a nearer segment.
-    fn distance(&self, line: &Streamline, p: Vector2<f64>) -> f64 {
-        // (A point off the grid is searched from the bucket it is clamped to: the buckets a ring
-        // away are still at least a ring's width from it, farther along the clamped axis.)
-        let (ci, cj) = self.bucket_of([p.x, p.y]);
-        let mut nearest = f64::INFINITY;
-        for ring in 0..self.nx.max(self.ny) {
-            let (i0, i1) = (ci.saturating_sub(ring), (ci + ring).min(self.nx - 1));
-            let (j0, j1) = (cj.saturating_sub(ring), (cj + ring).min(self.ny - 1));
-            for j in j0..=j1 {
-                for i in i0..=i1 {
-                    if i.abs_diff(ci) != ring && j.abs_diff(cj) != ring {
-                        continue;
-                    }
-                    for &s in &self.buckets[j * self.nx + i] {
-                        nearest = nearest.min(line.segment_distance(s as usize, p));
-                    }
-                }
-            }
-            // Buckets beyond this ring are at least `ring` bucket widths from `p`.
-            if nearest <= ring as f64 * self.size * (1.0 - 1e-9) {
-                break;
-            }
-        }
-        nearest
     }
 }
 
@@ -247,10 +194,11 @@ mod index {
         let probes: Vec<[f64; 2]> = (0..4000)
             .map(|k| [-5.0 + (k % 80) as f64 * 1.4, -6.0 + (k / 80) as f64 * 0.37])
             .collect();
-        let index = SegmentIndex::new(&line);
+        let buckets = line.segment_buckets().unwrap();
         for p in &probes {
             let scan = line.distance_to(*p);
-            let fast = index.distance(&line, Vector2::from(*p));
+            let q = Vector2::from(*p);
+            let fast = buckets.nearest(*p, |s, best| best.min(line.segment_distance(s, q)));
             assert_eq!(scan.to_bits(), fast.to_bits(), "at {p:?}");
         }
         let scanned = probes
