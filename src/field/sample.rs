@@ -204,9 +204,8 @@ impl Sampler {
 mod tests {
     use super::*;
 
-    /// A linear `W` is reproduced exactly, with its exact gradient, away from the edges.
-    #[test]
-    fn linear_fields_are_sampled_exactly() {
+    /// A 2 m × 1 m grid of 0.1 m cells holding `W = 0.1 + 0.3 x − 0.2 y`.
+    pub fn linear() -> (Grid, Vec<f64>) {
         let grid = Grid::covering([2.0, 1.0], 0.1);
         let mut w = vec![0.0; grid.len()];
         for j in 0..grid.ny {
@@ -215,6 +214,13 @@ mod tests {
                 w[grid.index(i, j)] = 0.1 + 0.3 * x - 0.2 * y;
             }
         }
+        (grid, w)
+    }
+
+    /// A linear `W` is reproduced exactly, with its exact gradient, away from the edges.
+    #[test]
+    fn linear_fields_are_sampled_exactly() {
+        let (grid, w) = linear();
         let s = Sampler::new(grid, ScaledW::from_plain(w), vec![true; grid.len()]);
         let p = [0.93, 0.41];
         assert!((s.w(p).unwrap() - (0.1 + 0.3 * 0.93 - 0.2 * 0.41)).abs() < 1e-12);
@@ -245,20 +251,14 @@ mod tests {
 
 #[cfg(test)]
 mod deep {
+    use super::tests::linear;
     use super::*;
 
     /// A linear `W` scaled far below f64's range is sampled with the same direction and the
     /// same value at its scale as at the scale of 1.
     #[test]
     fn fields_below_f64_keep_their_direction() {
-        let grid = Grid::covering([2.0, 1.0], 0.1);
-        let mut w = vec![0.0; grid.len()];
-        for j in 0..grid.ny {
-            for i in 0..grid.nx {
-                let [x, y] = grid.center(i, j);
-                w[grid.index(i, j)] = 0.1 + 0.3 * x - 0.2 * y;
-            }
-        }
+        let (grid, w) = linear();
         let plain = Sampler::new(grid, ScaledW::from_plain(w.clone()), vec![true; grid.len()]);
         let deep = ScaledW {
             mantissa: w,
