@@ -144,7 +144,7 @@ proptest! {
     fn fixed_length_arrays_reject_every_other_length(
         key in prop::sample::select(vec![
             "size", "external_acceleration", "walls.0.center", "walls.0.half_extents",
-            "agents.0.start", "agents.0.target",
+            "agents.0.start", "agents.0.target", "agents.0.initial_velocity", "origin",
         ]),
         len in prop_oneof![0usize..2, 3usize..6],
     ) {

@@ -91,3 +91,30 @@ fn viscous_settling_time_has_an_interior_minimum_twice_nadf_b_d_30() {
         "viscous best {t_min} s vs NADF B_d = 30 {nadf} s"
     );
 }
+
+/// The paper's motivation (eq. 2): viscous damping keeps the body off the walls only below an
+/// admissible initial speed. Launched at 8 m/s towards the first divider, viscous B = 0.7 (which
+/// crosses the room without contact from rest) hits it; NADF B_d = 10 does not. Both settle.
+#[test]
+fn from_8_m_s_towards_a_divider_viscous_damping_hits_it_and_nadf_does_not() {
+    let launched = |kind: &str, b: f64| {
+        summary(
+            "room-initial-velocity.toml",
+            &[
+                &format!("agents.0.controller.kind={kind}"),
+                &format!("agents.0.controller.b={b}"),
+                "duration=120",
+            ],
+        )
+    };
+    let viscous = launched("viscous", 0.7);
+    assert!(viscous.contacts > 0, "{viscous:?}");
+    assert!(
+        viscous.reached && viscous.settling_time.is_some(),
+        "{viscous:?}"
+    );
+    let nadf = launched("nadf", 10.0);
+    assert_eq!(nadf.contacts, 0, "{nadf:?}");
+    assert!(nadf.reached && nadf.settling_time.is_some(), "{nadf:?}");
+    assert!(nadf.peak_speed > 7.5, "launched at 8 m/s: {nadf:?}");
+}

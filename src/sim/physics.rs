@@ -46,7 +46,8 @@ pub fn insert_walls(physics: &mut PhysicsWorld, walls: &[WallShape]) -> Vec<Coll
         .collect()
 }
 
-/// Inserts an agent: a dynamic disc of the agent's radius and mass that does not rotate, never
+/// Inserts an agent at its start with its initial velocity: a dynamic disc of the agent's radius
+/// and mass that does not rotate, never
 /// sleeps (its control force changes every step) and uses continuous collision detection (a
 /// fast body must not tunnel through a thin wall). Contacts are frictionless and inelastic:
 /// a touch is a failure to be counted, not a dynamics to be modelled.
@@ -54,8 +55,10 @@ pub fn insert_agent(
     physics: &mut PhysicsWorld,
     agent: &Agent,
 ) -> (RigidBodyHandle, ColliderHandle) {
+    let [vx, vy] = agent.initial_velocity;
     let body = RigidBodyBuilder::dynamic()
         .translation(Vector::new(agent.start[0] as f32, agent.start[1] as f32))
+        .linvel(Vector::new(vx as f32, vy as f32))
         .lock_rotations()
         .can_sleep(false)
         .ccd_enabled(true);

@@ -312,6 +312,10 @@ pub struct Agent {
     /// Target position, m.
     #[serde(deserialize_with = "exactly")]
     pub target: [f64; 2],
+    /// Velocity at the start, m/s (default at rest). The paper's motivation (eq. 2): viscous
+    /// damping only works below an admissible initial speed; NADF from any.
+    #[serde(default, deserialize_with = "exactly")]
+    pub initial_velocity: [f64; 2],
     /// Disc radius, m.
     #[serde(default = "default_radius")]
     pub radius: f64,

@@ -412,6 +412,7 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
             );
         }
     }
+    finite_point(bad, &key("initial_velocity"), agent.initial_velocity);
     let start_ok = finite_point(bad, &key("start"), agent.start);
     let target_ok = finite_point(bad, &key("target"), agent.target);
     if !(agent.radius.is_finite() && agent.radius > 0.0) {
