@@ -116,7 +116,7 @@ fn a_missed_expectation_exits_1_and_says_what_failed() {
         "{stderr}"
     );
     assert!(
-        stderr.contains("robot: settling_time = 4.840 s, expected ≤ 3 s"),
+        stderr.contains("robot: settling_time = 4.850 s, expected ≤ 3 s"),
         "{stderr}"
     );
 }

@@ -92,6 +92,7 @@ mod tests {
             velocity: Vector1::new(speed),
             gradient: None,
             dt: 0.1,
+            touching: false,
         }
     }
 

@@ -8,11 +8,14 @@
 //! eq. 72–73), the clamping control ([`Clamp`], eq. 35) and, for the pendulum, a plain spring
 //! ([`Spring`], eq. 75). A [`Controller`] sums its laws
 //! (eq. 36: `F = -B_d M - K ∇V - K_c F_c`), adds the iterative bias ([`Bias`], eq. 48–50) and
-//! applies the speed limit ([`SpeedLimit`], §VI.2) last.
+//! applies the speed limit ([`SpeedLimit`], §VI.2) last. The linear parts of the laws (the
+//! damping and the clamp's or spring's stiffness) are integrated exactly over each step
+//! ([`Integrator`]), so that no gain is unstable.
 
 mod bias;
 mod clamp;
 mod guidance;
+mod integrator;
 mod nadf;
 mod sliding_mode;
 mod speed_limit;
@@ -22,6 +25,7 @@ mod viscous;
 pub use bias::Bias;
 pub use clamp::Clamp;
 pub use guidance::{Guidance, GuidanceMode};
+pub use integrator::{Integrator, Split, phi};
 pub use nadf::{Nadf, step};
 pub use sliding_mode::SlidingMode;
 pub use speed_limit::SpeedLimit;
@@ -62,12 +66,22 @@ pub struct ControlInput<const N: usize> {
     pub gradient: Option<SVector<f64, N>>,
     /// The control period, s.
     pub dt: f64,
+    /// Whether the body touched something during the last step (then its change of velocity
+    /// says nothing about the external force; see [`Integrator`]).
+    pub touching: bool,
 }
 
 /// One term of a control law: a force from the body's state and the guidance.
 pub trait ControlLaw<const N: usize>: Send + Sync {
     /// The force, N. Never returns a non-finite vector for finite inputs.
     fn force(&self, input: &ControlInput<N>) -> SVector<f64, N>;
+
+    /// The same force split into a constant part, a damping and a stiffness, for the exact
+    /// integration of [`Integrator`]; `split(i).force(v, e)` equals `force(i)`. The default is
+    /// all constant.
+    fn split(&self, input: &ControlInput<N>) -> Split<N> {
+        Split::explicit(self.force(input))
+    }
 }
 
 /// What a controller did in one step.
@@ -95,31 +109,56 @@ pub struct Controller<const N: usize> {
     pub speed_limit: Option<SpeedLimit>,
     /// Actuator saturation `F_max`, N (typical: a few times the guidance gain), if any.
     pub max_force: Option<f64>,
+    /// The exact integration of the damping and stiffness over a step; `None` hands the
+    /// physics the continuous law's force at the start of the step (explicit, unstable for
+    /// `B dt/m > 2`).
+    pub integrator: Option<Integrator<N>>,
 }
 
 impl<const N: usize> Controller<N> {
-    /// A controller that only sums `laws`.
-    pub fn new(laws: Vec<Box<dyn ControlLaw<N>>>) -> Self {
+    /// A controller that only sums `laws`, integrated exactly for a body of `mass` kg (the
+    /// moment of inertia, kg·m², for a joint).
+    pub fn new(laws: Vec<Box<dyn ControlLaw<N>>>, mass: f64) -> Self {
         Self {
             laws,
             clamp: None,
             bias: None,
             speed_limit: None,
             max_force: None,
+            integrator: Some(Integrator::new(mass)),
         }
     }
 
     /// The control force for one step, and what acted. Updates the bias's settling detector.
     pub fn step(&mut self, input: &ControlInput<N>) -> ControlOutput<N> {
-        let mut total: SVector<f64, N> = self.laws.iter().map(|law| law.force(input)).sum();
+        if let Some(integrator) = &mut self.integrator {
+            integrator.observe(input);
+        }
+        let v = &input.velocity;
+        let mut split = self
+            .laws
+            .iter()
+            .fold(Split::explicit(SVector::zeros()), |sum, law| {
+                sum.add(law.split(input), v)
+            });
+        if let Some(bias) = &self.bias {
+            split.explicit += bias.beta();
+        }
         let mut clamping = false;
         if let Some(clamp) = &self.clamp {
-            clamping = clamp.active(input);
-            total += clamp.force(input);
+            // The clamp's rest band: what the other forces do to the velocity in one step.
+            let rest_speed = self.integrator.as_ref().map_or(0.0, |i| {
+                Clamp::rest_speed((split.explicit + i.external()).norm(), input.dt, i.mass)
+            });
+            clamping = clamp.active(input, rest_speed);
+            if clamping {
+                split.stiffness += clamp.kc;
+            }
         }
-        if let Some(bias) = &self.bias {
-            total += bias.beta();
-        }
+        let mut total = match &self.integrator {
+            Some(integrator) => integrator.force(&split, input),
+            None => split.force(v, &input.offset),
+        };
         if let Some(max) = self.max_force {
             // Saturation keeps the direction: scaled down, damping is still dissipative.
             let norm = total.norm();
@@ -137,6 +176,9 @@ impl<const N: usize> Controller<N> {
         } else {
             SVector::zeros()
         };
+        if let Some(integrator) = &mut self.integrator {
+            integrator.applied(input, &force);
+        }
         let bias_updated = self
             .bias
             .as_mut()
@@ -183,7 +225,6 @@ impl Controller<2> {
             clamp: settings.clamp.map(|c| Clamp {
                 kc: c.kc,
                 sigma: c.sigma,
-                mass,
             }),
             bias: settings.bias.map(|b| Bias::new(b.alpha, b.dwell)),
             speed_limit: (settings.speed_limit.is_some() || settings.brake.is_some()).then(|| {
@@ -194,6 +235,7 @@ impl Controller<2> {
                 }
             }),
             max_force: settings.max_force,
+            integrator: Some(Integrator::new(mass)),
         }
     }
 }
@@ -226,6 +268,7 @@ mod tests {
             velocity: Vector2::from(velocity),
             gradient: gradient.map(Vector2::from),
             dt: 0.01,
+            touching: false,
         }
     }
 
@@ -260,6 +303,8 @@ mod tests {
             dwell: 0.5,
         });
         let mut c = Controller::from_settings(&s, GuidanceKind::Normalized, 1.0);
+        // The laws' sum as the paper states it (the exact integration is tested below).
+        c.integrator = None;
         // Inside σ, moving away along +x, gradient +x (uphill): guidance -K·0.2/0.25, NADF
         // -B_d·v, clamp -K_c·e.
         let out = c.step(&input([0.2, 0.0], [0.1, 0.0], Some([1.0, 0.0])));
@@ -287,6 +332,7 @@ mod tests {
         let mut s = settings(ControllerKind::Viscous);
         s.max_force = Some(2.0);
         let mut c = Controller::from_settings(&s, GuidanceKind::Gradient, 1.0);
+        c.integrator = None;
         // Guidance -K·g = (-3, 0), damping -B·v = (0, -40): 40.1 N, scaled to 2 N.
         let out = c.step(&input([5.0, 0.0], [0.0, 4.0], Some([3.0, 0.0])));
         let expected = Vector2::new(-3.0, -40.0) * (2.0 / 1609.0f64.sqrt());

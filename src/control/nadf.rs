@@ -7,9 +7,9 @@
 //! is left alone, so B_d can be large without slowing the body (paper §III, Proposition 2).
 //! Eq. 10 prints `Φ(-g·v)`; eq. 9, 17, 19 and the text fix `Φ(gᵀv)` (design page).
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
-use super::{ControlInput, ControlLaw, unit};
+use super::{ControlInput, ControlLaw, Split, unit};
 
 /// NADF damping.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,6 +41,20 @@ impl Nadf {
 }
 
 impl Nadf {
+    /// The projector `P` with `M(x, v) = P v` for this step: the identity minus `u uᵀ` when the
+    /// motion along `u` is downhill (then it is not damped), the identity otherwise (eq. 9 with
+    /// the step Φ fixed for the step).
+    pub fn damped_directions<const N: usize>(
+        v: &SVector<f64, N>,
+        g: &SVector<f64, N>,
+    ) -> SMatrix<f64, N, N> {
+        let identity = SMatrix::identity();
+        match unit(g) {
+            Some(u) if step(u.dot(v)) == 0.0 => identity - u * u.transpose(),
+            _ => identity,
+        }
+    }
+
     /// The damping force `F_d = -B_d · M(x, v)`, N, for velocity `v` (m/s) where the gradient
     /// is `g` (eq. 10).
     pub fn force<const N: usize>(
@@ -56,6 +70,11 @@ impl<const N: usize> ControlLaw<N> for Nadf {
     fn force(&self, input: &ControlInput<N>) -> SVector<f64, N> {
         let g = input.gradient.unwrap_or_else(SVector::zeros);
         Nadf::force(self, &input.velocity, &g)
+    }
+
+    fn split(&self, input: &ControlInput<N>) -> Split<N> {
+        let g = input.gradient.unwrap_or_else(SVector::zeros);
+        Split::damping(self.b_d, Nadf::damped_directions(&input.velocity, &g))
     }
 }
 
@@ -122,6 +141,27 @@ mod tests {
             Nadf { b_d: 1.0 }.force(&Vector1::new(1.0), &g),
             Vector1::new(-1.0)
         );
+    }
+
+    #[test]
+    fn the_split_is_the_same_force() {
+        let nadf = Nadf { b_d: 3.0 };
+        for (v, g) in [
+            ([1.0, 2.0], [0.3, -0.7]),
+            ([-1.0, 0.5], [1.0, 0.0]),
+            ([2.0, 0.0], [0.0, 0.0]),
+        ] {
+            let input = ControlInput {
+                offset: Vector2::new(1.0, 1.0),
+                velocity: Vector2::from(v),
+                gradient: Some(Vector2::from(g)),
+                dt: 0.01,
+                touching: false,
+            };
+            let split = ControlLaw::split(&nadf, &input);
+            let f = split.force(&input.velocity, &input.offset);
+            assert!((f - ControlLaw::force(&nadf, &input)).norm() < 1e-12);
+        }
     }
 
     #[test]

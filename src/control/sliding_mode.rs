@@ -73,6 +73,7 @@ mod tests {
             velocity: Vector2::zeros(),
             gradient: Some(Vector2::new(1e-6, 0.0)),
             dt: 0.01,
+            touching: false,
         };
         assert_eq!(law().force(&input), Vector2::new(-100.0, 0.0));
         // Faster than v_d along the guidance: S flips and the law brakes.
@@ -96,6 +97,7 @@ mod tests {
             velocity: Vector2::new(0.0, 1.0),
             gradient: None,
             dt: 0.01,
+            touching: false,
         };
         assert_eq!(law().force(&input), Vector2::new(0.0, -100.0));
     }

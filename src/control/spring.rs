@@ -3,7 +3,7 @@
 
 use nalgebra::SVector;
 
-use super::{ControlInput, ControlLaw};
+use super::{ControlInput, ControlLaw, Split};
 
 /// The spring law.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -16,6 +16,10 @@ pub struct Spring {
 impl<const N: usize> ControlLaw<N> for Spring {
     fn force(&self, input: &ControlInput<N>) -> SVector<f64, N> {
         -input.offset * self.k
+    }
+
+    fn split(&self, _: &ControlInput<N>) -> Split<N> {
+        Split::stiffness(self.k)
     }
 }
 
@@ -31,6 +35,7 @@ mod tests {
             velocity: Vector1::new(3.0),
             gradient: None,
             dt: 0.01,
+            touching: false,
         };
         assert_eq!(Spring { k: 20.0 }.force(&input), Vector1::new(10.0));
     }

@@ -1,9 +1,9 @@
 //! Linear viscous damping, eq. 1: `F_d = -B · v`. It damps motion in every direction alike,
 //! the useful part along the guidance included — the reason it must trade speed for safety.
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
-use super::{ControlInput, ControlLaw};
+use super::{ControlInput, ControlLaw, Split};
 
 /// Viscous damping.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -24,6 +24,10 @@ impl<const N: usize> ControlLaw<N> for Viscous {
     fn force(&self, input: &ControlInput<N>) -> SVector<f64, N> {
         Viscous::force(self, &input.velocity)
     }
+
+    fn split(&self, _: &ControlInput<N>) -> Split<N> {
+        Split::damping(self.b, SMatrix::identity())
+    }
 }
 
 #[cfg(test)]
@@ -40,6 +44,7 @@ mod tests {
             velocity: v,
             gradient: g,
             dt: 0.01,
+            touching: false,
         };
         for g in [Some(Vector2::new(1.0, 0.0)), None] {
             assert_eq!(ControlLaw::force(&d, &input(g)), Vector2::new(-0.7, 1.4));

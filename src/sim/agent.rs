@@ -359,6 +359,7 @@ impl AgentRun {
             velocity: v,
             gradient: self.field.gradient(x.into()),
             dt,
+            touching: !self.touching.is_empty(),
         };
         let mut out = self.controller.step(&input);
         // Finite in f64 but beyond f32's range is still not finite for Rapier.

@@ -143,10 +143,12 @@ pub fn insert(physics: &mut PhysicsWorld, pendulum: &Pendulum) -> PendulumRun {
             .local_anchor2(Vector::new(0.0, l as f32)),
     );
     let c = &pendulum.controller;
-    let mut controller = Controller::new(vec![
-        Box::new(Spring { k: c.k }),
-        Box::new(Viscous { b: c.b }),
-    ]);
+    // The torque turns the bob about the pivot: M L² plus the bob's own ½ M r².
+    let inertia = pendulum.mass * (l * l + 0.5 * BOB_RADIUS * BOB_RADIUS);
+    let mut controller = Controller::new(
+        vec![Box::new(Spring { k: c.k }), Box::new(Viscous { b: c.b })],
+        inertia,
+    );
     controller.bias = c.bias.map(|b| Bias::new(b.alpha, b.dwell));
     let e0 = (pendulum.target - pendulum.start).abs();
     PendulumRun {
@@ -176,6 +178,7 @@ impl PendulumRun {
             velocity: Vector1::new(self.state.omega),
             gradient: None,
             dt,
+            touching: false,
         };
         let out = self.controller.step(&input);
         let torque = out.force.x;

@@ -114,15 +114,84 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
     issues
 }
 
-/// Settings that are valid but will not work as intended, as `(key path, message)`: so far,
-/// condition 40 of Proposition 3 (the guidance must beat the external force outside the
-/// clamping region, or the body may never reach the target).
+/// Settings that are valid but will not work as intended, as `(key path, message)`:
+/// condition 40 of Proposition 3 (`condition_40`) and gains faster than the time step
+/// (`unresolved_gains`).
+pub fn warnings(world: &World) -> Vec<(String, String)> {
+    let mut out = condition_40(world);
+    out.extend(unresolved_gains(world));
+    out
+}
+
+/// Gains whose time scale is shorter than the step: a damping with `B dt/m > 2` or a stiffness
+/// with `K dt²/m > 4` (`ω dt > 2`), the limits beyond which an explicit step diverges. The
+/// control laws' linear parts are integrated exactly (`control::Integrator`), so such a run
+/// is stable and its rest points are right, but what happens within one damping time or one
+/// period is not resolved: the warning gives the step that would resolve it.
+pub fn unresolved_gains(world: &World) -> Vec<(String, String)> {
+    let dt = world.dt;
+    let mut out = Vec::new();
+    let mut check = |key: String, what: &str, x: f64, bound: f64, resolving: f64| {
+        if x > bound {
+            out.push((
+                key,
+                format!(
+                    "{what} is faster than the step: {x:.3} > {bound} (an explicit step would diverge). The law is integrated exactly, so the run is stable and its rest points are right, but the motion within one step is not resolved; dt ≤ {resolving:.3e} s resolves it"
+                ),
+            ));
+        }
+    };
+    for (i, agent) in world.agents.iter().enumerate() {
+        let c = &agent.controller;
+        let m = agent.mass;
+        if let (Some(b), ControllerKind::Nadf | ControllerKind::Viscous) = (c.b, c.kind) {
+            check(
+                format!("agents.{i}.controller.b"),
+                "the damping (B·dt/m)",
+                b * dt / m,
+                2.0,
+                2.0 * m / b,
+            );
+        }
+        if let Some(clamp) = c.clamp {
+            check(
+                format!("agents.{i}.controller.clamp.kc"),
+                "the clamp's stiffness (K_c·dt²/m)",
+                clamp.kc * dt * dt / m,
+                4.0,
+                2.0 * (m / clamp.kc).sqrt(),
+            );
+        }
+    }
+    for (i, p) in world.pendulums.iter().enumerate() {
+        let inertia = p.mass * p.length * p.length;
+        let c = &p.controller;
+        check(
+            format!("pendulums.{i}.controller.b"),
+            "the damping (B·dt/(M L²))",
+            c.b * dt / inertia,
+            2.0,
+            2.0 * inertia / c.b,
+        );
+        check(
+            format!("pendulums.{i}.controller.k"),
+            "the stiffness (K·dt²/(M L²))",
+            c.k * dt * dt / inertia,
+            4.0,
+            2.0 * (inertia / c.k).sqrt(),
+        );
+    }
+    out
+}
+
+/// Condition 40 of Proposition 3: the guidance must beat the external force outside the
+/// clamping region, or the body may never reach the target.
 ///
 /// With normalized guidance the thrust outside σ is at least `K·min(1, σ/r_c)` (σ is the clamp's
 /// radius, or `r_c` without a clamp), and the external force along the guidance is at most
 /// `m·|a|`; the warning fires when the first does not exceed the second. Gradient guidance
 /// needs the solved field to check, so it is not checked here. Sliding mode needs `F_0 > m·|a|`.
-pub fn warnings(world: &World) -> Vec<(String, String)> {
+pub fn condition_40(world: &World) -> Vec<(String, String)> {
     let mut out = Vec::new();
     let [ax, ay] = world.external_acceleration;
     let a = ax.hypot(ay);
