@@ -282,6 +282,7 @@ mod tests {
             distance_covered: Some(20.0),
             lateral_speed_rms: 0.1,
             lateral_reversals: 3,
+            bias_updates: 0,
             faults: crate::metrics::Faults::default(),
         }
     }

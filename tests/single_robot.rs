@@ -131,7 +131,7 @@ fn the_bias_removes_the_offset_the_clamp_leaves() {
         updates.len()
     );
     assert!(
-        updates[0].1.notes[0].contains("β ← u"),
+        updates[0].1.notes[0].contains("β ← holding force"),
         "{:?}",
         updates[0].1.notes
     );

@@ -22,7 +22,7 @@ mod speed_limit;
 mod spring;
 mod viscous;
 
-pub use bias::Bias;
+pub use bias::{Bias, CONVERGED};
 pub use clamp::Clamp;
 pub use guidance::{Guidance, GuidanceMode};
 pub use integrator::{Integrator, Split, phi};
@@ -226,7 +226,7 @@ impl Controller<2> {
                 kc: c.kc,
                 sigma: c.sigma,
             }),
-            bias: settings.bias.map(|b| Bias::new(b.alpha, b.dwell)),
+            bias: settings.bias.map(|b| Bias::new(b.alpha, b.dwell, mass)),
             speed_limit: (settings.speed_limit.is_some() || settings.brake.is_some()).then(|| {
                 SpeedLimit {
                     v_max: settings.speed_limit.unwrap_or(f64::INFINITY),

@@ -74,6 +74,9 @@ crate::measured! {
         /// Reversals of the motion across the start-to-target line (between excursions faster
         /// than [`LATERAL_REVERSAL_SPEED`]).
         pub lateral_reversals: usize,
+        /// Updates of the iterative bias β (eq. 49) that changed it by more than
+        /// `control::CONVERGED` of its size; zero without the bias option.
+        pub bias_updates: usize [column("updates")],
         /// Numerical faults met during the run (all zero in a healthy run).
         pub faults: Faults,
     }
@@ -127,6 +130,7 @@ pub struct Metrics {
     start: Vector2<f64>,
     distance_at: Option<f64>,
     distance_covered: Option<f64>,
+    bias_updates: usize,
     lateral_axis: Vector2<f64>,
     lateral_square_sum: f64,
     states: usize,
@@ -166,6 +170,7 @@ impl Metrics {
             start,
             distance_at,
             distance_covered: (distance_at == Some(0.0)).then_some(0.0),
+            bias_updates: 0,
             lateral_axis,
             lateral_square_sum: 0.0,
             states: 0,
@@ -230,6 +235,11 @@ impl Metrics {
         self.contacts += n;
     }
 
+    /// Counts an update of the bias β.
+    pub fn record_bias_update(&mut self) {
+        self.bias_updates += 1;
+    }
+
     /// The dynamic path so far.
     pub fn path(&self) -> &[[f64; 2]] {
         &self.path
@@ -257,6 +267,7 @@ impl Metrics {
             peak_speed: self.peak_speed,
             final_speed: self.final_speed,
             distance_covered: self.distance_covered,
+            bias_updates: self.bias_updates,
             lateral_speed_rms: if self.states > 0 {
                 (self.lateral_square_sum / self.states as f64).sqrt()
             } else {

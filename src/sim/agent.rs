@@ -370,8 +370,9 @@ impl AgentRun {
         if out.bias_updated
             && let Some(beta) = self.controller.beta()
         {
+            self.metrics.record_bias_update();
             self.log.notes.push(format!(
-                "settling instant at distance {:.4} m: β ← u = [{:.4}, {:.4}] N (update {})",
+                "settling instant at distance {:.4} m: β ← holding force = [{:.4}, {:.4}] N (update {})",
                 input.offset.norm(),
                 beta.x,
                 beta.y,

@@ -149,7 +149,7 @@ pub fn insert(physics: &mut PhysicsWorld, pendulum: &Pendulum) -> PendulumRun {
         vec![Box::new(Spring { k: c.k }), Box::new(Viscous { b: c.b })],
         inertia,
     );
-    controller.bias = c.bias.map(|b| Bias::new(b.alpha, b.dwell));
+    controller.bias = c.bias.map(|b| Bias::new(b.alpha, b.dwell, inertia));
     let e0 = (pendulum.target - pendulum.start).abs();
     PendulumRun {
         pendulum: pendulum.clone(),
@@ -193,7 +193,7 @@ impl PendulumRun {
                 beta: self.state.beta,
             };
             self.state.note = Some(format!(
-                "settling instant at error {:.6} rad: β ← u = {:.4} N·m (update {})",
+                "settling instant at error {:.6} rad: β ← holding torque = {:.4} N·m (update {})",
                 update.error,
                 update.beta,
                 self.updates.len() + 1
