@@ -35,7 +35,7 @@ fn solves(c: &mut Criterion) {
     for cells in [256, 512, 1024, 2048] {
         let s = room(cells, &[]);
         group.bench_with_input(BenchmarkId::new("multigrid", cells), &s, |b, s| {
-            b.iter(|| solve_w(&s.grid, &s.reachable, s.target_cell, 1e-10, None))
+            b.iter(|| solve_w(&s.grid, &s.reachable, &s.target_cells, 1e-10, None))
         });
         // The first solve alone (to the relative residual of 1e-10 the target names),
         // without the nested solves that restore relative precision in the deep regions.
@@ -62,7 +62,7 @@ fn solves(c: &mut Criterion) {
     group.sample_size(10);
     let s = space("maze.toml", &[]);
     group.bench_function("multigrid", |b| {
-        b.iter(|| solve_w(&s.grid, &s.reachable, s.target_cell, 1e-10, None))
+        b.iter(|| solve_w(&s.grid, &s.reachable, &s.target_cells, 1e-10, None))
     });
     group.finish();
 
@@ -74,7 +74,7 @@ fn solves(c: &mut Criterion) {
     let old = solve_w(
         &before.grid,
         &before.reachable,
-        before.target_cell,
+        &before.target_cells,
         1e-10,
         None,
     )
@@ -87,7 +87,7 @@ fn solves(c: &mut Criterion) {
                 solve_w(
                     &after.grid,
                     &after.reachable,
-                    after.target_cell,
+                    &after.target_cells,
                     1e-10,
                     warm,
                 )

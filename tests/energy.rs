@@ -11,16 +11,17 @@ fn nadf_energy_never_increases_with_gradient_guidance() {
     let agent = &world.agents[0];
     let (k, m) = (agent.controller.k(), agent.mass);
     let mut sim = Simulation::new(&world).unwrap();
-    let cell = world.field.cell;
+    // Within the rim of the target disc the guidance is the bowl that brings the body to the
+    // target point, not −K∇V of the harmonic field (V = 0 on the disc).
+    let rim = sim.agents[0].field.harmonic().unwrap().rim();
     let energy0 = k * sim.agents[0].field.potential(agent.start);
     let mut last = (energy0, f64::INFINITY);
     let mut checked = 0;
     while !sim.finished() {
         let state = sim.step().remove(0);
         let energy = k * state.potential + 0.5 * m * state.velocity.norm_squared();
-        // The discrete field is the source of eq. 3 at the target cell, not harmonic there:
-        // the proposition is checked on steps that start and end more than two cells away.
-        if state.distance > 2.0 * cell && last.1 > 2.0 * cell {
+        // The proposition is checked on every step that starts and ends outside the disc's rim.
+        if state.distance > rim && last.1 > rim {
             assert!(
                 energy <= last.0 + 1e-4,
                 "Ξ grew from {} to {energy} at t = {}",
@@ -33,7 +34,7 @@ fn nadf_energy_never_increases_with_gradient_guidance() {
     }
     let summary = &sim.summaries()[0];
     assert!(summary.reached && summary.contacts == 0, "{summary:?}");
-    assert!(checked > 300, "only {checked} steps checked");
+    assert!(checked > 200, "only {checked} steps checked");
     assert!(
         last.0 < 0.01 * energy0,
         "Ξ went from {energy0} to {}",

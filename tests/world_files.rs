@@ -238,3 +238,46 @@ fn fixed_length_arrays_of_the_wrong_length_are_rejected_at_their_line() {
     let e = errors(MINIMAL, &["external_acceleration=[1.0]"]);
     assert!(e.contains("got 1"), "{e}");
 }
+
+#[test]
+fn a_target_disc_that_is_not_positive_reaches_the_start_or_a_wall_is_a_located_error() {
+    let with = |r: &str, extra: &str| {
+        let text = MINIMAL.replace(
+            "target = [3.0, 2.0]\n",
+            &format!("target = [3.0, 2.0]\ntarget_radius = {r}\n"),
+        );
+        errors(&format!("{text}{extra}"), &[])
+    };
+    for r in ["0.0", "-0.1", "nan", "inf"] {
+        let e = with(r, "");
+        assert!(
+            e.contains("w.toml:7") && e.contains("`agents.0.target_radius`"),
+            "{r}: {e}"
+        );
+    }
+    // The start is 2.24 m from the target.
+    let e = with("2.5", "");
+    assert!(
+        e.contains("`agents.0.target_radius`") && e.contains("reaches the start"),
+        "{e}"
+    );
+    // A disc wall 0.8 m from the target: its edge 0.5 m away, the agent's radius 0.2 m.
+    let wall = "\n[[walls]]\nshape = \"disc\"\ncenter = [3.0, 1.2]\nradius = 0.3\n";
+    let e = with("0.4", wall);
+    assert!(
+        e.contains("`agents.0.target_radius`") && e.contains("walls.0") && e.contains("smaller"),
+        "{e}"
+    );
+    let ok = MINIMAL.replace(
+        "target = [3.0, 2.0]\n",
+        "target = [3.0, 2.0]\ntarget_radius = 0.25\n",
+    );
+    let w = load_str(&format!("{ok}{wall}"), Path::new("w.toml"), &[]).unwrap();
+    assert_eq!(w.agents[0].target_disc(), 0.25);
+    // By default, the agent's radius.
+    let w = load_str(MINIMAL, Path::new("w.toml"), &[]).unwrap();
+    assert_eq!(
+        (w.agents[0].target_radius, w.agents[0].target_disc()),
+        (None, 0.2)
+    );
+}

@@ -106,6 +106,7 @@ impl<const N: usize> Bias<N> {
     ///         offset: Vector1::new(0.0),
     ///         velocity: Vector1::new(v),
     ///         gradient: None,
+    ///         curvature: None,
     ///         dt,
     ///         touching: false,
     ///     };
@@ -166,6 +167,7 @@ mod tests {
             offset: Vector1::new(0.1),
             velocity: Vector1::new(speed),
             gradient: None,
+            curvature: None,
             dt: 0.1,
             touching: false,
         }

@@ -71,6 +71,7 @@ mod tests {
             offset: Vector2::from(offset),
             velocity: Vector2::from(velocity),
             gradient: None,
+            curvature: None,
             dt: 0.01,
             touching: false,
         }

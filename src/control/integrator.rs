@@ -37,17 +37,19 @@ use nalgebra::{SMatrix, SVector};
 use super::ControlInput;
 
 /// A law's force at one instant, split into what the integrator treats exactly and the rest:
-/// `F = explicit − damping · damped · v − stiffness · e`.
+/// `F(x + δ, v) ≈ explicit − stiffness · δ − damping · damped · v` for a small displacement δ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Split<const N: usize> {
-    /// The part integrated as a constant force over the step, N.
+    /// The force at the body's position, without the damping, N.
     pub explicit: SVector<f64, N>,
     /// The damping coefficient B, N·s/m (N·m·s/rad for a joint); zero for none.
     pub damping: f64,
     /// The projector `P` onto the damped directions (the identity for viscous damping).
     pub damped: SMatrix<f64, N, N>,
-    /// The stiffness K pulling towards the target, N/m (N·m/rad for a joint).
-    pub stiffness: f64,
+    /// The stiffness `S = −∂F/∂x`, N/m (N·m/rad for a joint), symmetric and positive
+    /// semi-definite: `K I` for a spring to the target, `K ∇∇V` (its positive part) for the
+    /// gradient guidance.
+    pub stiffness: SMatrix<f64, N, N>,
 }
 
 impl<const N: usize> Split<N> {
@@ -57,31 +59,30 @@ impl<const N: usize> Split<N> {
             explicit: force,
             damping: 0.0,
             damped: SMatrix::identity(),
-            stiffness: 0.0,
+            stiffness: SMatrix::zeros(),
         }
     }
 
     /// Damping `-B P v`.
     pub fn damping(b: f64, damped: SMatrix<f64, N, N>) -> Self {
         Self {
-            explicit: SVector::zeros(),
             damping: b,
             damped,
-            stiffness: 0.0,
-        }
-    }
-
-    /// A spring `-K e`.
-    pub fn stiffness(k: f64) -> Self {
-        Self {
-            stiffness: k,
             ..Self::explicit(SVector::zeros())
         }
     }
 
-    /// The force the split stands for at velocity `v` and offset `e` (the continuous law).
-    pub fn force(&self, v: &SVector<f64, N>, e: &SVector<f64, N>) -> SVector<f64, N> {
-        self.explicit - self.damped * v * self.damping - e * self.stiffness
+    /// A spring `-K e` towards the target, `e` the offset from it.
+    pub fn spring(k: f64, e: &SVector<f64, N>) -> Self {
+        Self {
+            stiffness: SMatrix::identity() * k,
+            ..Self::explicit(-e * k)
+        }
+    }
+
+    /// The force the split stands for at velocity `v` (the continuous law at the body).
+    pub fn force(&self, v: &SVector<f64, N>) -> SVector<f64, N> {
+        self.explicit - self.damped * v * self.damping
     }
 
     /// Adds another law's split. Only one damping law can be integrated exactly; a second
@@ -98,6 +99,38 @@ impl<const N: usize> Split<N> {
         }
         self
     }
+}
+
+/// The positive semi-definite part of a symmetric matrix: its negative eigenvalues set to zero.
+/// Only a restoring stiffness is integrated implicitly; a negative one (a saddle of the field,
+/// which pushes away) stays explicit, where it cannot make the step's system singular.
+pub fn positive_part<const N: usize>(m: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+    if !m.iter().all(|c| c.is_finite()) {
+        return SMatrix::zeros();
+    }
+    // Cyclic Jacobi rotations: exact after one rotation for N = 2, a few sweeps beyond.
+    let mut a = (m + m.transpose()) * 0.5;
+    let mut vectors = SMatrix::<f64, N, N>::identity();
+    for _ in 0..16 {
+        for p in 0..N {
+            for q in p + 1..N {
+                if a[(p, q)] == 0.0 {
+                    continue;
+                }
+                let theta = 0.5 * (2.0 * a[(p, q)]).atan2(a[(q, q)] - a[(p, p)]);
+                let (sin, cos) = theta.sin_cos();
+                let mut rotation = SMatrix::<f64, N, N>::identity();
+                rotation[(p, p)] = cos;
+                rotation[(q, q)] = cos;
+                rotation[(p, q)] = sin;
+                rotation[(q, p)] = -sin;
+                a = rotation.transpose() * a * rotation;
+                vectors *= rotation;
+            }
+        }
+    }
+    let clipped = SVector::<f64, N>::from_fn(|k, _| a[(k, k)].max(0.0));
+    vectors * SMatrix::from_diagonal(&clipped) * vectors.transpose()
 }
 
 /// `φ(x) = (1 − e^{−x})/x`, the fraction of a constant force's impulse that survives damping
@@ -139,15 +172,16 @@ impl<const N: usize> Integrator<N> {
     /// estimated by [`Integrator::observe`].
     ///
     /// ```
-    /// use nadf::control::{Integrator, Split};
+    /// use nadf::control::{ControlInput, Integrator, Split};
     /// use nalgebra::{Matrix1, Vector1};
     /// // B = 10⁴ kg/s on 1 kg with dt = 0.01 s: explicitly, v' = v − 100 v.
     /// let integrator = Integrator::new(1.0);
     /// let split = Split::damping(1e4, Matrix1::identity());
-    /// let input = nadf::control::ControlInput {
+    /// let input = ControlInput {
     ///     offset: Vector1::new(1.0),
     ///     velocity: Vector1::new(2.0),
     ///     gradient: None,
+    ///     curvature: None,
     ///     dt: 0.01,
     ///     touching: false,
     /// };
@@ -156,19 +190,26 @@ impl<const N: usize> Integrator<N> {
     /// assert!((f.x - (-200.0)).abs() < 1e-9);
     /// ```
     pub fn force(&self, split: &Split<N>, input: &ControlInput<N>) -> SVector<f64, N> {
-        let (v, e, dt, m) = (input.velocity, input.offset, input.dt, self.mass);
-        if split.damping == 0.0 && split.stiffness == 0.0 {
+        let (v, dt, m) = (input.velocity, input.dt, self.mass);
+        if split.damping == 0.0 && split.stiffness == SMatrix::<f64, N, N>::zeros() {
             return split.explicit;
         }
-        let f = split.explicit + self.external - e * split.stiffness;
+        let identity = SMatrix::<f64, N, N>::identity();
         let x = split.damping * dt / m;
-        let (decay, phi) = ((-x).exp(), phi(x));
-        let kappa = split.stiffness * dt * dt / m;
         let p = split.damped;
-        let free = SMatrix::<f64, N, N>::identity() - p;
-        let damped = p * (v * decay + f * (phi * dt / m)) / (1.0 + phi * kappa);
-        let undamped = free * (v + f * (dt / m)) / (1.0 + kappa);
-        (damped + undamped - v) * (m / dt) - self.external
+        // Over the step the damped components decay by e^{−x} and keep φ(x) of a constant
+        // force's impulse; the free ones decay not at all and keep all of it.
+        let decay = p * (-x).exp() + (identity - p);
+        let weight = p * phi(x) + (identity - p);
+        let f = split.explicit + self.external;
+        // The stiffness acts at the end of the step, x + dt v': solve
+        // (I + (dt²/m) Φ S) v' = E v + (dt/m) Φ f.
+        let system = identity + weight * split.stiffness * (dt * dt / m);
+        let rhs = decay * v + weight * f * (dt / m);
+        let Some(next) = system.try_inverse().map(|inverse| inverse * rhs) else {
+            return split.force(&v);
+        };
+        (next - v) * (m / dt) - self.external
     }
 
     /// Updates the estimate of the external force from the step that ended at `input`: what
@@ -202,6 +243,7 @@ mod tests {
             offset: Vector1::new(e),
             velocity: Vector1::new(v),
             gradient: None,
+            curvature: None,
             dt,
             touching: false,
         }
@@ -229,6 +271,18 @@ mod tests {
             out.push((x, v));
         }
         out
+    }
+
+    #[test]
+    fn only_the_restoring_part_of_a_curvature_is_kept() {
+        // Eigenvalues 3 and −1 along (1, 1)/√2 and (1, −1)/√2.
+        let m = Matrix2::new(1.0, 2.0, 2.0, 1.0);
+        let p = positive_part(&m);
+        assert!((p - Matrix2::new(1.5, 1.5, 1.5, 1.5)).norm() < 1e-12, "{p}");
+        assert_eq!(
+            positive_part(&Matrix2::new(f64::NAN, 0.0, 0.0, 1.0)),
+            Matrix2::zeros()
+        );
     }
 
     #[test]
@@ -268,9 +322,9 @@ mod tests {
         // Explicitly, K dt²/m > 4 diverges; implicitly the energy never grows.
         for (k, b) in [(1e4, 0.0), (1e6, 0.0), (1e6, 1e5), (50.0, 100.0)] {
             let path = simulate(
-                |_, _| {
+                |x, _| {
                     Split::damping(b, nalgebra::Matrix1::identity())
-                        .add(Split::stiffness(k), &Vector1::zeros())
+                        .add(Split::spring(k, &Vector1::new(x)), &Vector1::zeros())
                 },
                 0.0,
                 0.01,
@@ -296,9 +350,9 @@ mod tests {
         for (k, b) in [(10.0, 10.0), (1e4, 10.0), (1e4, 1e4)] {
             let g = 5.657;
             let path = simulate(
-                |_, _| {
+                |x, _| {
                     Split::damping(b, nalgebra::Matrix1::identity())
-                        .add(Split::stiffness(k), &Vector1::zeros())
+                        .add(Split::spring(k, &Vector1::new(x)), &Vector1::zeros())
                 },
                 g,
                 0.01,
@@ -321,6 +375,7 @@ mod tests {
             offset: Vector2::new(3.0, 0.0),
             velocity: Vector2::new(-2.0, 0.5),
             gradient: None,
+            curvature: None,
             dt: 0.01,
             touching: false,
         };

@@ -25,14 +25,14 @@ mod viscous;
 pub use bias::{Bias, CONVERGED};
 pub use clamp::Clamp;
 pub use guidance::{Guidance, GuidanceMode};
-pub use integrator::{Integrator, Split, phi};
+pub use integrator::{Integrator, Split, phi, positive_part};
 pub use nadf::{Nadf, step};
 pub use sliding_mode::SlidingMode;
 pub use speed_limit::SpeedLimit;
 pub use spring::Spring;
 pub use viscous::Viscous;
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 use crate::world::{ControllerKind, ControllerSettings, GuidanceKind};
 
@@ -64,6 +64,9 @@ pub struct ControlInput<const N: usize> {
     /// The gradient `g = ∇V` of the guidance potential at the body, 1/m; `None` where the field
     /// is undefined (then guidance is zero and NADF damps like viscous damping).
     pub gradient: Option<SVector<f64, N>>,
+    /// The curvature `∇∇V` of the guidance potential at the body, 1/m² (symmetric), where the
+    /// field gives one: the guidance's stiffness, integrated implicitly ([`Integrator`]).
+    pub curvature: Option<SMatrix<f64, N, N>>,
     /// The control period, s.
     pub dt: f64,
     /// Whether the body touched something during the last step (then its change of velocity
@@ -152,12 +155,12 @@ impl<const N: usize> Controller<N> {
             });
             clamping = clamp.active(input, rest_speed);
             if clamping {
-                split.stiffness += clamp.kc;
+                split = split.add(Split::spring(clamp.kc, &input.offset), v);
             }
         }
         let mut total = match &self.integrator {
             Some(integrator) => integrator.force(&split, input),
-            None => split.force(v, &input.offset),
+            None => split.force(v),
         };
         if let Some(max) = self.max_force {
             // Saturation keeps the direction: scaled down, damping is still dissipative.
@@ -267,6 +270,7 @@ mod tests {
             offset: Vector2::from(offset),
             velocity: Vector2::from(velocity),
             gradient: gradient.map(Vector2::from),
+            curvature: None,
             dt: 0.01,
             touching: false,
         }

@@ -155,11 +155,12 @@ mod tests {
                 offset: Vector2::new(1.0, 1.0),
                 velocity: Vector2::from(v),
                 gradient: Some(Vector2::from(g)),
+                curvature: None,
                 dt: 0.01,
                 touching: false,
             };
             let split = ControlLaw::split(&nadf, &input);
-            let f = split.force(&input.velocity, &input.offset);
+            let f = split.force(&input.velocity);
             assert!((f - ControlLaw::force(&nadf, &input)).norm() < 1e-12);
         }
     }

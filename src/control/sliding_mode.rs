@@ -72,6 +72,7 @@ mod tests {
             offset: Vector2::new(5.0, 0.0),
             velocity: Vector2::zeros(),
             gradient: Some(Vector2::new(1e-6, 0.0)),
+            curvature: None,
             dt: 0.01,
             touching: false,
         };
@@ -96,6 +97,7 @@ mod tests {
             offset: Vector2::new(5.0, 0.0),
             velocity: Vector2::new(0.0, 1.0),
             gradient: None,
+            curvature: None,
             dt: 0.01,
             touching: false,
         };

@@ -18,8 +18,8 @@ impl<const N: usize> ControlLaw<N> for Spring {
         -input.offset * self.k
     }
 
-    fn split(&self, _: &ControlInput<N>) -> Split<N> {
-        Split::stiffness(self.k)
+    fn split(&self, input: &ControlInput<N>) -> Split<N> {
+        Split::spring(self.k, &input.offset)
     }
 }
 
@@ -34,6 +34,7 @@ mod tests {
             offset: Vector1::new(-0.5),
             velocity: Vector1::new(3.0),
             gradient: None,
+            curvature: None,
             dt: 0.01,
             touching: false,
         };

@@ -43,6 +43,7 @@ mod tests {
             offset: Vector2::new(1.0, 1.0),
             velocity: v,
             gradient: g,
+            curvature: None,
             dt: 0.01,
             touching: false,
         };

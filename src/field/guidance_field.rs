@@ -2,7 +2,7 @@
 //! attractive-repulsive potential (the baseline of the narrow corridor, §VI.6), behind one
 //! interface for the simulation, the faults monitor and the recording.
 
-use nalgebra::Vector2;
+use nalgebra::{Matrix2, Vector2};
 
 use super::firas::AttractiveRepulsive;
 use super::mask::Disc;
@@ -62,6 +62,22 @@ impl GuidanceField {
             Self::Harmonic(h) => h.gradient(p),
             Self::AttractiveRepulsive(f) => f.gradient(p),
         }
+    }
+
+    /// The curvature `∇∇V` (or `∇∇U`) at `p`, 1/m², by central differences of the gradient
+    /// half a cell (1 cm for Khatib's field) either side, symmetrized; `None` where a gradient
+    /// is undefined. The integrator treats its positive part as the guidance's stiffness.
+    pub fn curvature(&self, p: [f64; 2]) -> Option<Matrix2<f64>> {
+        let h = match self {
+            Self::Harmonic(f) => 0.5 * f.grid().cell,
+            Self::AttractiveRepulsive(_) => 0.01,
+        };
+        let at = |dx: f64, dy: f64| self.gradient([p[0] + dx, p[1] + dy]);
+        let dx = (at(h, 0.0)? - at(-h, 0.0)?) / (2.0 * h);
+        let dy = (at(0.0, h)? - at(0.0, -h)?) / (2.0 * h);
+        let m = Matrix2::from_columns(&[dx, dy]);
+        let m = (m + m.transpose()) * 0.5;
+        m.iter().all(|c| c.is_finite()).then_some(m)
     }
 
     /// The potential at `p`: `V` in [0, 1], or Khatib's `U` in metres.

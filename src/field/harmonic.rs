@@ -37,6 +37,8 @@ pub struct HarmonicField {
     pub blocked: Vec<bool>,
     /// The target, m.
     pub target: [f64; 2],
+    /// The radius of the target disc where `V = 0`, m (see [`HarmonicField::gradient`]).
+    pub target_radius: f64,
     /// Conjugate gradient iterations over all solves.
     pub iterations: usize,
     /// Solves: the first plus the nested ones for the deep regions (see [`solve_w`]).
@@ -84,7 +86,7 @@ impl HarmonicField {
         let solution = solve_w(
             &space.grid,
             &space.reachable,
-            space.target_cell,
+            &space.target_cells,
             world.field.tolerance,
             warm,
         );
@@ -100,6 +102,7 @@ impl HarmonicField {
             sampler: Sampler::new(space.grid, solution.w, space.reachable),
             blocked: space.blocked,
             target: agent.target,
+            target_radius: agent.target_disc(),
             iterations: solution.iterations,
             solves: solution.solves,
             nested: solution.nested,
@@ -144,7 +147,55 @@ impl HarmonicField {
     /// is returned at magnitude [`GRADIENT_FLOOR`] with its exact direction: the paper's
     /// `−K∇V` is still nothing (no force that small survives the conversion to Rapier's f32),
     /// while normalized guidance and NADF's split, which use the direction only, keep it.
+    ///
+    /// **The target disc.** `V = 0` on the disc, so its gradient vanishes there, and within a
+    /// cell or two outside it the interpolated gradient mixes in the disc's cells. Within
+    /// [`HarmonicField::rim`] of the target the gradient therefore continues as a bowl,
+    /// `∇V = |∇V(rim)| · (x − x_T)/rim`: radial (the disc is an equipotential, so the field
+    /// leaves it radially), as large as the field at the rim in that direction and falling
+    /// linearly to zero at the target, so a body is brought to the target point itself rather
+    /// than left anywhere on the disc.
+    ///
+    /// ```
+    /// # let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/room-two-dividers.toml");
+    /// # let world = nadf::world::load(&path, &[]).unwrap();
+    /// let field = nadf::field::HarmonicField::solve(&world, &world.agents[0]).unwrap();
+    /// let [tx, ty] = field.target;
+    /// // Inside the disc, half-way to its centre: pointing away from the target (V grows).
+    /// let g = field.gradient([tx + 0.5 * field.target_radius, ty]).unwrap();
+    /// assert!(g.x > 0.0 && g.y.abs() < 1e-12 * g.x);
+    /// ```
     pub fn gradient(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
+        let e = Vector2::new(p[0] - self.target[0], p[1] - self.target[1]);
+        let d = e.norm();
+        let rim = self.rim();
+        if d < rim {
+            if d == 0.0 {
+                return Some(Vector2::zeros());
+            }
+            let edge = [
+                self.target[0] + e.x * rim / d,
+                self.target[1] + e.y * rim / d,
+            ];
+            if let Some(g) = self.sampled_gradient(edge)
+                && g.norm() > 0.0
+                && g.norm().is_finite()
+            {
+                return Some(e * (g.norm() / rim));
+            }
+        }
+        self.sampled_gradient(p)
+    }
+
+    /// The radius of the bowl around the target (see [`HarmonicField::gradient`]), m: half as
+    /// large again as the target disc, so that it does not depend on the grid, and at least
+    /// 1.5 cells beyond the disc, where the interpolation no longer reaches the disc's cells.
+    pub fn rim(&self) -> f64 {
+        (1.5 * self.target_radius).max(self.target_radius + 1.5 * self.grid().cell)
+    }
+
+    /// The interpolated gradient of the solved cells at `p` (see [`HarmonicField::gradient`]).
+    fn sampled_gradient(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
         let (g, e) = self.sampler.grad_w_scaled(p)?;
         let true_size = g.map(|c| ldexp(c, e));
         let size = g.norm();
@@ -158,7 +209,8 @@ impl HarmonicField {
     /// target): with no direction there, a run could only stand still.
     pub fn check_start(&self, agent: &Agent) -> Result<(), FieldError> {
         let [sx, sy] = agent.start;
-        let at_target = (sx - self.target[0]).hypot(sy - self.target[1]) <= self.grid().cell;
+        let at_target = (sx - self.target[0]).hypot(sy - self.target[1])
+            <= self.grid().cell.max(self.target_radius);
         if at_target || self.gradient(agent.start).and_then(|g| unit(&g)).is_some() {
             Ok(())
         } else {
@@ -177,7 +229,17 @@ impl HarmonicField {
 
     /// The streamline from `start`, at most `max_length` long, m.
     pub fn streamline_within(&self, start: [f64; 2], max_length: f64) -> Streamline {
-        super::streamline::streamline(&self.sampler, start, self.target, max_length)
+        let cell = self.grid().cell;
+        // The direction of descent, −∇V, with the bowl of the target disc (as a unit vector:
+        // deep in a maze |∇V| is at the floor, whose square underflows).
+        super::streamline::integrate(
+            |p| self.gradient(p).and_then(|g| unit(&-g)),
+            start,
+            self.target,
+            0.5 * cell,
+            cell,
+            max_length,
+        )
     }
 }
 
@@ -196,20 +258,21 @@ pub struct HarmonicSolution {
     pub nested: LevelStats,
 }
 
-/// Solves for `W` on the `reachable` cells with `W = 1` at `target`, each solve to a relative
-/// residual of `tolerance`: the first solve over the whole grid, then the nested levels below
-/// what it resolves. `warm` is a previous `W` on the same grid to start the first solve from
-/// (after a small change of the world), if any.
+/// Solves for `W` on the `reachable` cells with `W = 1` on the `target` cells (the target
+/// disc), each solve to a relative residual of `tolerance`: the first solve over the whole
+/// grid, then the nested levels below what it resolves. `warm` is a previous `W` on the same
+/// grid to start the first solve from (after a small change of the world), if any.
 pub fn solve_w(
     grid: &Grid,
     reachable: &[bool],
-    target: (usize, usize),
+    target: &[usize],
     tolerance: f64,
     warm: Option<&[f64]>,
 ) -> HarmonicSolution {
-    let t = grid.index(target.0, target.1);
     let mut unknown = reachable.to_vec();
-    unknown[t] = false;
+    for &t in target {
+        unknown[t] = false;
+    }
     let mut w = match warm {
         Some(w) if w.len() == grid.len() => w
             .iter()
@@ -218,7 +281,9 @@ pub fn solve_w(
             .collect(),
         _ => vec![0.0; grid.len()],
     };
-    w[t] = 1.0;
+    for &t in target {
+        w[t] = 1.0;
+    }
     let first = multigrid::solve(grid, &unknown, &mut w, tolerance, MAX_ITERATIONS);
     let pending = deep_cells(grid, &unknown, &w, DEPTH_STEP);
     let mut w = ScaledW::from_plain(w);
@@ -288,7 +353,13 @@ mod tests {
         let blocked = vec![false; grid.len()];
         let target = (0, 5);
         let reachable = reachable_from(&grid, &blocked, target);
-        let s = solve_w(&grid, &reachable, target, 1e-12, None);
+        let s = solve_w(
+            &grid,
+            &reachable,
+            &[grid.index(target.0, target.1)],
+            1e-12,
+            None,
+        );
         assert!(s.solves > 3, "{} solves", s.solves);
         let row: Vec<f64> = (0..grid.nx).map(|i| s.w.value(grid.index(i, 5))).collect();
         assert!(

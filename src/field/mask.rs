@@ -40,6 +40,9 @@ pub struct FreeSpace {
     pub blocked: Vec<bool>,
     /// The target's cell.
     pub target_cell: (usize, usize),
+    /// The target disc: the reachable cells whose centres are within the agent's target
+    /// radius (plus half a cell) of the target, the target's cell among them, where `V = 0`.
+    pub target_cells: Vec<usize>,
     /// `true` for the free cells connected to the target cell.
     pub reachable: Vec<bool>,
 }
@@ -95,10 +98,21 @@ impl FreeSpace {
                 radius: agent.radius,
             });
         }
+        // Cells within half a cell beyond the disc: the outermost nodes held at V = 0 then
+        // straddle the circle, so the discrete disc has the disc's radius on average (with
+        // the centres inside it only, it is half a cell smaller, and the field near it
+        // depends on the grid).
+        let target_cells = disc_cells(
+            &grid,
+            &reachable,
+            agent.target,
+            agent.target_disc() + 0.5 * grid.cell,
+        );
         Ok(Self {
             grid,
             blocked,
             target_cell,
+            target_cells,
             reachable,
         })
     }
@@ -122,6 +136,30 @@ impl FreeSpace {
             .filter_map(|agent| Self::of(world, agent).err())
             .collect()
     }
+}
+
+/// The `reachable` cells whose centres are within `radius` of `center` (the cell of `center`
+/// itself always, as a point target).
+pub fn disc_cells(grid: &Grid, reachable: &[bool], center: [f64; 2], radius: f64) -> Vec<usize> {
+    let mut cells = Vec::new();
+    let reach = (radius / grid.cell).ceil() as i64 + 1;
+    if let Some((ci, cj)) = grid.cell_of(center) {
+        for dj in -reach..=reach {
+            for di in -reach..=reach {
+                let (i, j) = (ci as i64 + di, cj as i64 + dj);
+                if i < 0 || j < 0 || i >= grid.nx as i64 || j >= grid.ny as i64 {
+                    continue;
+                }
+                let (i, j) = (i as usize, j as usize);
+                let [x, y] = grid.center(i, j);
+                let inside = (di, dj) == (0, 0) || (x - center[0]).hypot(y - center[1]) <= radius;
+                if inside && reachable[grid.index(i, j)] {
+                    cells.push(grid.index(i, j));
+                }
+            }
+        }
+    }
+    cells
 }
 
 /// How many cells of a free space are reachable, blocked, and free but unreachable.

@@ -557,7 +557,13 @@ mod tests {
         }
         let target = (1, 1);
         let reachable = reachable_from(&grid, &blocked, target);
-        let s = solve_w(&grid, &reachable, target, 1e-12, None);
+        let s = solve_w(
+            &grid,
+            &reachable,
+            &[grid.index(target.0, target.1)],
+            1e-12,
+            None,
+        );
         let w = &s.w;
         // Walk the corridor from the target.
         let mut path = vec![grid.index(1, 1)];

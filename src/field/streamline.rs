@@ -3,7 +3,6 @@
 
 use nalgebra::Vector2;
 
-use super::sample::Sampler;
 use crate::buckets::Buckets;
 
 /// A polyline from the start towards the target.
@@ -13,26 +12,6 @@ pub struct Streamline {
     pub points: Vec<[f64; 2]>,
     /// Whether the path came within one cell of the target.
     pub reached: bool,
-}
-
-/// Integrates the streamline with the midpoint rule at steps of half a cell until it is within
-/// one cell of `target`, the guidance vanishes, or it has walked `max_length` metres.
-pub fn streamline(
-    sampler: &Sampler,
-    start: [f64; 2],
-    target: [f64; 2],
-    max_length: f64,
-) -> Streamline {
-    let cell = sampler.grid().cell;
-    // ∇W = -∇V: the direction of descent, at the cells' scale (its size does not matter).
-    integrate(
-        |p| sampler.grad_w_scaled(p).map(|(g, _)| g),
-        start,
-        target,
-        0.5 * cell,
-        cell,
-        max_length,
-    )
 }
 
 /// Integrates `ẋ = f(x)/|f(x)|` with the midpoint rule at steps of `h` metres from `start` until

@@ -88,7 +88,8 @@ crate::measured! {
     pub struct Faults {
         /// Steps in which the guidance was undefined: the gradient vanished or reversed from
         /// one step to the next (the body is on a critical point, e.g. a saddle), the field was
-        /// flat, or the body was off the field. Not counted within two cells of the target.
+        /// flat, or the body was off the field. Not counted within two cells of the target or
+        /// within the rim of its disc (`HarmonicField::rim`).
         pub guidance_lost_steps: usize,
         /// Steps whose control force could not be given to Rapier (not finite in f32); zero
         /// was applied instead.

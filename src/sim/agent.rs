@@ -358,6 +358,7 @@ impl AgentRun {
             offset: x - Vector2::from(self.agent.target),
             velocity: v,
             gradient: self.field.gradient(x.into()),
+            curvature: self.field.curvature(x.into()),
             dt,
             touching: !self.touching.is_empty(),
         };

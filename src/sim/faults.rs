@@ -6,7 +6,7 @@
 use nalgebra::Vector2;
 
 use crate::control::unit;
-use crate::field::GuidanceField;
+use crate::field::{GuidanceField, HarmonicField};
 use crate::metrics::Faults;
 
 /// How deep a body may overlap a wall before it counts as pushed into it, m. Rapier's solver
@@ -60,7 +60,15 @@ impl FaultMonitor {
         let mut events = Vec::new();
         let p: [f64; 2] = o.position.into();
         let cell = o.field.cell();
-        let near_target = (o.position - Vector2::from(o.field.target())).norm() <= 2.0 * cell;
+        // The target's own neighbourhood: two cells, or the rim of a harmonic field's target
+        // disc (inside it the guidance is the bowl to the target point, and the direction
+        // turns about as the body settles there).
+        let near = o
+            .field
+            .harmonic()
+            .map_or(0.0, HarmonicField::rim)
+            .max(2.0 * cell);
+        let near_target = (o.position - Vector2::from(o.field.target())).norm() <= near;
         let gradient = o.field.gradient(p);
         let direction = gradient.and_then(|g| unit(&g));
         // Along a streamline the guidance turns slowly; a reversal from one step to the next

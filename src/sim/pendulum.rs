@@ -177,6 +177,7 @@ impl PendulumRun {
             offset: Vector1::new(self.state.theta - self.pendulum.target),
             velocity: Vector1::new(self.state.omega),
             gradient: None,
+            curvature: None,
             dt,
             touching: false,
         };

@@ -319,6 +319,14 @@ pub struct Agent {
     /// Disc radius, m.
     #[serde(default = "default_radius")]
     pub radius: f64,
+    /// Radius of the target disc, m: the harmonic field has `V = 0` on the free cells whose
+    /// centres are this close to the target (default: the agent's radius, trimmed to free
+    /// space where walls are nearer). A point target has zero capacity in 2-D, so with one
+    /// cell at `V = 0` the field depends on the grid (it tends to 1 everywhere as the cell
+    /// shrinks); a disc of fixed size makes the continuum problem well posed. Inside the disc
+    /// the guidance continues as a bowl that brings the body to the target point itself.
+    #[serde(default)]
+    pub target_radius: Option<f64>,
     /// Mass, kg.
     #[serde(default = "default_mass")]
     pub mass: f64,
@@ -330,6 +338,14 @@ pub struct Agent {
     /// What this agent's run must show, on top of the world's `[expect]`.
     #[serde(default)]
     pub expect: Option<Expect>,
+}
+
+impl Agent {
+    /// The radius of the target disc, m: `target_radius`, or the agent's radius by default
+    /// (the field trims the default to free space).
+    pub fn target_disc(&self) -> f64 {
+        self.target_radius.unwrap_or(self.radius)
+    }
 }
 
 /// One pendulum (`[[pendulums]]`): a point mass `mass` on a massless rod of `length` about a

@@ -516,6 +516,32 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
             );
         }
     }
+    if let Some(r_t) = agent.target_radius {
+        if !(r_t.is_finite() && r_t > 0.0) {
+            bad(
+                key("target_radius"),
+                format!("must be a positive finite number, got {r_t}"),
+            );
+        } else if start_ok && target_ok {
+            let d = (agent.start[0] - agent.target[0]).hypot(agent.start[1] - agent.target[1]);
+            if d <= r_t {
+                bad(
+                    key("target_radius"),
+                    format!(
+                        "{r_t} m reaches the start, {d:.3} m from the target: the agent would start on its target"
+                    ),
+                );
+            } else if let Some(wall) = blocking_wall(world, agent.target, agent.radius + r_t) {
+                bad(
+                    key("target_radius"),
+                    format!(
+                        "the target disc of {r_t} m reaches where the agent's centre cannot be: within its radius ({} m) of {wall}; make it smaller",
+                        agent.radius
+                    ),
+                );
+            }
+        }
+    }
     if start_ok {
         for (j, other) in world.agents[..i].iter().enumerate() {
             let d = (agent.start[0] - other.start[0]).hypot(agent.start[1] - other.start[1]);
