@@ -34,7 +34,7 @@ pub use viscous::Viscous;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::world::{ControllerKind, ControllerSettings, GuidanceKind};
+use crate::world::{ControllerKind, ControllerSettings, GuidanceKind, Integration};
 
 /// Below this `|∇V|` the direction of the gradient is undefined (a saddle, an unreachable cell,
 /// a flat region): guidance is zero and NADF falls back to viscous damping (design page).
@@ -238,7 +238,7 @@ impl Controller<2> {
                 }
             }),
             max_force: settings.max_force,
-            integrator: Some(Integrator::new(mass)),
+            integrator: (settings.integration == Integration::Exact).then(|| Integrator::new(mass)),
         }
     }
 }
@@ -262,6 +262,7 @@ mod tests {
             max_force: None,
             clamp: None,
             bias: None,
+            integration: Integration::Exact,
         }
     }
 

@@ -15,9 +15,9 @@ pub use error::{WorldError, WorldErrors};
 pub use load::{Override, WorldFile, load, load_str};
 pub use schema::{
     Agent, Attraction, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K,
-    Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind, LoadedMap, MAX_CELLS, MapSettings,
-    OUTER_WALL_THICKNESS, Pendulum, PendulumController, PendulumExpect, SensorSettings,
-    UnknownCells, Wall, World,
+    Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind, Integration, LoadedMap, MAX_CELLS,
+    MapSettings, OUTER_WALL_THICKNESS, Pendulum, PendulumController, PendulumExpect,
+    SensorSettings, UnknownCells, Wall, World,
 };
 pub use shapes::{
     WallShape, all_wall_shapes, all_walls, drawn_walls, named_walls, outer_walls, wall_shape,

@@ -444,6 +444,22 @@ pub struct ControllerSettings {
     /// Iterative blind error cancellation (eq. 48–50).
     #[serde(default)]
     pub bias: Option<BiasSettings>,
+    /// How the law's force is handed to the physics each step (default `exact`).
+    #[serde(default)]
+    pub integration: Integration,
+}
+
+/// How a controller's force is integrated over a physics step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Integration {
+    /// The damping and the stiffnesses (clamp, spring, the gradient guidance's curvature) are
+    /// integrated exactly over the step, so no gain is unstable (`control::Integrator`).
+    #[default]
+    Exact,
+    /// The continuous law's force at the start of the step, held over it: the textbook
+    /// explicit scheme, unstable for `B dt/m > 2`. For comparison with published simulations.
+    Explicit,
 }
 
 /// The guidance gain used when `k` is not given.
