@@ -40,8 +40,9 @@ fn an_obstruction_makes_khatib_oscillate_under_viscous_damping_but_not_under_nad
     }
     // The empty corridor: straight down the middle.
     assert_eq!(empty.lateral_reversals, 0, "{empty:?}");
-    // B = 0.3: sustained sideways oscillation once past the block (figure 38), about the paper's
-    // 25 m in 10 s.
+    // B = 0.3: sideways oscillation once past the block (figure 38), about the paper's 25 m in
+    // 10 s (measured 20.2 m). The corridor is 102 m long, so no run is capped by its target at
+    // 10 s (NADF B_d = 5 would cover 50 m in it without the block).
     assert!(light.lateral_reversals >= 6, "{light:?}");
     assert!(
         light.lateral_speed_rms > 0.2 && light.lateral_speed_rms > 100.0 * empty.lateral_speed_rms,
@@ -50,14 +51,17 @@ fn an_obstruction_makes_khatib_oscillate_under_viscous_damping_but_not_under_nad
     assert!((18.0..28.0).contains(&covered(&light)), "{light:?}");
     // B = 3: far slower (figure 39: 4 m in 10 s).
     assert!(covered(&heavy) < 0.5 * covered(&light), "{heavy:?}");
-    // NADF B_d = 5: no sustained oscillation, and farther than B = 0.3 (figure 40).
+    // NADF B_d = 5: no sustained oscillation, and farther than B = 0.3 (figure 40). The paper
+    // says more than twice as far; measured 26.4 m against 20.2 m (1.31×): NADF damps the
+    // motion that climbs into the block's repulsion, and the body meets it at 3 m/s and
+    // leaves it at 0.6 m/s (B_d = 30: 39.5 m, 1.96×).
     assert!(nadf5.lateral_reversals <= 3, "{nadf5:?}");
     assert!(
         nadf5.lateral_speed_rms < 0.5 * light.lateral_speed_rms,
         "{nadf5:?}"
     );
     assert!(covered(&nadf5) > covered(&light), "{nadf5:?}");
-    // NADF B_d = 30: no slower (figure 41).
+    // NADF B_d = 30: no slower (figure 41; measured 50 % farther).
     assert!(covered(&nadf30) >= 0.9 * covered(&nadf5), "{nadf30:?}");
     for s in [&nadf5, &nadf30] {
         assert_eq!(s.contacts, 0, "{s:?}");
@@ -101,4 +105,48 @@ fn nadf_brakes_to_a_stop_before_a_barrier() {
         .map(|(_, a)| a.velocity.norm())
         .fold(0.0, f64::max);
     assert!(fastest > 3.0, "{fastest}");
+}
+
+/// The paper's B = 0.3 oscillation is "sustained" (figure 38). In the sandbox it decays: the
+/// lateral RMS speed over the three thirds of a 60 s run is 0.45, 0.025 and 0.002 m/s (the body
+/// reaches the target at about 40 s). The test states what is measured, and fails if the
+/// oscillation stops decaying.
+#[test]
+fn the_viscous_oscillation_past_the_block_decays() {
+    let world = common::world(
+        "corridor-obstruction.toml",
+        &[
+            "agents.0.controller.kind=\"viscous\"",
+            "agents.0.controller.b=0.3",
+            "duration=60",
+        ],
+    );
+    let (states, s) = common::trace(&world);
+    assert_eq!(s.contacts, 0, "{s:?}");
+    let third = states.len() / 3;
+    let rms = |part: &[(f64, nadf::sim::AgentState)]| {
+        (part.iter().map(|(_, a)| a.velocity.y.powi(2)).sum::<f64>() / part.len() as f64).sqrt()
+    };
+    let (first, last) = (rms(&states[..third]), rms(&states[2 * third..]));
+    assert!(first > 0.3, "{first}");
+    assert!(last < 0.05 * first, "{first} then {last}");
+}
+
+/// Figure 42: "the travel distance is unaffected" by sensor noise. Without a force cap, walls
+/// sensed up to 0.1 m off (10 Hz) and a position estimate up to 0.05 m off (10 Hz) both cover
+/// over 95 % of the 50 m the noiseless robot covers in 10 s (measured 48.6 and 49.5 m). Walls
+/// off by up to 0.5 m do not (5 m, with a 10 N cap; see the worlds' comments).
+#[test]
+fn moderate_sensor_noise_leaves_the_distance_unaffected_without_a_force_cap() {
+    let clean = corridor("corridor.toml", "nadf", 30.0);
+    for world in ["corridor-noise.toml", "corridor-position-noise.toml"] {
+        let w = common::world(world, &[]);
+        assert_eq!(w.agents[0].controller.max_force, None);
+        let s = common::summary_of(&w);
+        assert!(s.contacts == 0 && s.reached, "{world}: {s:?}");
+        assert!(
+            covered(&s) > 0.95 * covered(&clean),
+            "{world}: {s:?} vs {clean:?}"
+        );
+    }
 }

@@ -54,6 +54,8 @@ pub struct AgentRun {
     rebuild_failed: bool,
     /// The last sensor reading: how far each wall is sensed outside its true position, m.
     offsets: Vec<f64>,
+    /// The error of the agent's estimate of its position since the last reading, m.
+    position_error: Vector2<f64>,
     /// Replans so far (the first field counts as one).
     replans: usize,
     /// What the current step has produced so far.
@@ -149,6 +151,7 @@ impl AgentRun {
             frozen: false,
             rebuild_failed: false,
             offsets: Vec::new(),
+            position_error: Vector2::zeros(),
             replans: 1,
             log: StepLog::default(),
         }
@@ -196,7 +199,9 @@ impl AgentRun {
         plan.sensed_now = match &mut self.sensor {
             Some(sensor) if sensor.due(time) => {
                 self.offsets = sensor.read(walls.len());
-                true
+                self.position_error = Vector2::from(sensor.position_error());
+                // Without wall noise a reading changes nothing the field is solved from.
+                sensor.settings.noise > 0.0
             }
             _ => false,
         };
@@ -352,8 +357,10 @@ impl AgentRun {
         }
     }
 
-    /// The control force at position `x` and velocity `v`, from the current field.
+    /// The control force at position `x` and velocity `v`, from the current field, as the
+    /// controller sees them (the position through the sensor's position error).
     fn control(&mut self, x: Vector2<f64>, v: Vector2<f64>, dt: f64) -> ControlOutput<2> {
+        let x = x + self.position_error;
         let input = ControlInput {
             offset: x - Vector2::from(self.agent.target),
             velocity: v,

@@ -6,6 +6,9 @@
 //! range data, without filtering. Readings come at `rate` Hz from `t = 0`. The noise comes from a
 //! SplitMix64 generator seeded by the world's seed and the agent's index, so a run is
 //! reproducible to the bit.
+//!
+//! With `position_noise` the agent's estimate of its own position is off too: each reading
+//! draws an error uniform in `[-σ, σ]` per axis (after the walls' draws), held until the next.
 
 use crate::world::SensorSettings;
 
@@ -46,6 +49,19 @@ impl Sensor {
             .collect()
     }
 
+    /// The error of the position estimate for this reading, m (zero without position noise;
+    /// call after [`Sensor::read`]).
+    pub fn position_error(&mut self) -> [f64; 2] {
+        let sigma = self.settings.position_noise;
+        if sigma == 0.0 {
+            return [0.0, 0.0];
+        }
+        [
+            sigma * (2.0 * self.uniform() - 1.0),
+            sigma * (2.0 * self.uniform() - 1.0),
+        ]
+    }
+
     /// A uniform draw in `[0, 1)`.
     fn uniform(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
@@ -69,6 +85,7 @@ mod tests {
         Sensor::new(
             SensorSettings {
                 noise: 0.5,
+                position_noise: 0.0,
                 rate: 10.0,
             },
             seed,
@@ -92,6 +109,16 @@ mod tests {
         assert_eq!(b.read(5), sensor(7, 0).read(5));
         assert_ne!(b.read(5), sensor(7, 1).read(5));
         assert_ne!(sensor(7, 0).read(5), sensor(8, 0).read(5));
+    }
+
+    #[test]
+    fn position_errors_are_in_the_band_and_zero_without_position_noise() {
+        let mut s = sensor(3, 0);
+        assert_eq!(s.position_error(), [0.0, 0.0]);
+        s.settings.position_noise = 0.2;
+        let draws: Vec<[f64; 2]> = (0..500).map(|_| s.position_error()).collect();
+        assert!(draws.iter().flatten().all(|d| (-0.2..0.2).contains(d)));
+        assert!(draws.iter().flatten().any(|d| d.abs() > 0.15));
     }
 
     #[test]

@@ -501,9 +501,15 @@ pub struct BiasSettings {
 #[serde(deny_unknown_fields)]
 pub struct SensorSettings {
     /// Half-width of the uniform noise on each wall's sensed position, m: every reading moves
-    /// each wall's boundary out or in by an independent draw from `[-noise, noise]`.
+    /// each wall's boundary out or in by an independent draw from `[-noise, noise]` (default 0).
+    #[serde(default)]
     pub noise: f64,
-    /// Readings per second; the field is rebuilt from each reading, Hz.
+    /// Half-width of the uniform noise on the agent's estimate of its own position, m: every
+    /// reading draws an error in `[-σ, σ]` per axis, which the controller sees (the guidance at
+    /// the estimate, the offset from the target) until the next reading (default 0).
+    #[serde(default)]
+    pub position_noise: f64,
+    /// Readings per second; with wall noise the field is rebuilt from each reading, Hz.
     pub rate: f64,
 }
 

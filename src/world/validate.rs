@@ -477,6 +477,7 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
     check_controller(bad, &|k| key(&format!("controller.{k}")), &agent.controller);
     if let Some(sensor) = &agent.sensor {
         non_negative(bad, &key("sensor.noise"), sensor.noise);
+        non_negative(bad, &key("sensor.position_noise"), sensor.position_noise);
         positive(bad, &key("sensor.rate"), sensor.rate);
         if sensor.rate.is_finite()
             && world.dt.is_finite()
