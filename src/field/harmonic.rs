@@ -297,10 +297,27 @@ pub fn solve_w(
     }
 }
 
+/// The field with `W = 1` on the one free cell `target` of the `blocked` mask, to 1e-12: the
+/// point target of the solver tests.
+#[cfg(test)]
+pub(crate) fn solve_from_cell(
+    grid: &Grid,
+    blocked: &[bool],
+    target: (usize, usize),
+) -> HarmonicSolution {
+    let reachable = super::laplace::reachable_from(grid, blocked, target);
+    solve_w(
+        grid,
+        &reachable,
+        &[grid.index(target.0, target.1)],
+        1e-12,
+        None,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::field::laplace::reachable_from;
     use crate::field::nested::REACH;
 
     /// A field flat around the start gives it no direction: an error, not a run that stands
@@ -352,14 +369,7 @@ mod tests {
         let grid = Grid::covering([12.0, 0.5], 0.05);
         let blocked = vec![false; grid.len()];
         let target = (0, 5);
-        let reachable = reachable_from(&grid, &blocked, target);
-        let s = solve_w(
-            &grid,
-            &reachable,
-            &[grid.index(target.0, target.1)],
-            1e-12,
-            None,
-        );
+        let s = solve_from_cell(&grid, &blocked, target);
         assert!(s.solves > 3, "{} solves", s.solves);
         let row: Vec<f64> = (0..grid.nx).map(|i| s.w.value(grid.index(i, 5))).collect();
         assert!(

@@ -534,7 +534,7 @@ impl Levels<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::field::harmonic::solve_w;
+    use crate::field::harmonic::solve_from_cell;
     use crate::field::laplace::reachable_from;
 
     /// A serpentine corridor one cell wide, 20,000 cells long: `W` falls by 2 − √3 per cell,
@@ -557,13 +557,7 @@ mod tests {
         }
         let target = (1, 1);
         let reachable = reachable_from(&grid, &blocked, target);
-        let s = solve_w(
-            &grid,
-            &reachable,
-            &[grid.index(target.0, target.1)],
-            1e-12,
-            None,
-        );
+        let s = solve_from_cell(&grid, &blocked, target);
         let w = &s.w;
         // Walk the corridor from the target.
         let mut path = vec![grid.index(1, 1)];

@@ -148,48 +148,57 @@ pub fn unresolved_gains(world: &World) -> Vec<(String, String)> {
             ));
         }
     };
-    for (i, agent) in world.agents.iter().enumerate() {
-        let c = &agent.controller;
-        let m = agent.mass;
-        let exact = c.integration == Integration::Exact;
-        if let (Some(b), ControllerKind::Nadf | ControllerKind::Viscous) = (c.b, c.kind) {
+    // One body of mass (or moment of inertia) `m`: its damping and its stiffness.
+    let mut body = |prefix: &str,
+                    unit: &str,
+                    m: f64,
+                    damping: Option<(&str, f64)>,
+                    stiffness: Option<(&str, f64)>,
+                    exact: bool| {
+        if let Some((name, b)) = damping {
+            let what = format!("the damping (B·dt/{unit})");
             check(
-                format!("agents.{i}.controller.b"),
-                "the damping (B·dt/m)",
+                format!("{prefix}.{name}"),
+                &what,
                 b * dt / m,
                 2.0,
                 2.0 * m / b,
                 exact,
             );
         }
-        if let Some(clamp) = c.clamp {
+        if let Some((name, k)) = stiffness {
+            let what = format!("the stiffness (K·dt²/{unit})");
+            let resolving = 2.0 * (m / k).sqrt();
             check(
-                format!("agents.{i}.controller.clamp.kc"),
-                "the clamp's stiffness (K_c·dt²/m)",
-                clamp.kc * dt * dt / m,
+                format!("{prefix}.{name}"),
+                &what,
+                k * dt * dt / m,
                 4.0,
-                2.0 * (m / clamp.kc).sqrt(),
+                resolving,
                 exact,
             );
         }
+    };
+    for (i, agent) in world.agents.iter().enumerate() {
+        let c = &agent.controller;
+        let damped = matches!(c.kind, ControllerKind::Nadf | ControllerKind::Viscous);
+        body(
+            &format!("agents.{i}.controller"),
+            "m",
+            agent.mass,
+            c.b.filter(|_| damped).map(|b| ("b", b)),
+            c.clamp.map(|clamp| ("clamp.kc", clamp.kc)),
+            c.integration == Integration::Exact,
+        );
     }
     for (i, p) in world.pendulums.iter().enumerate() {
-        let inertia = p.mass * p.length * p.length;
         let c = &p.controller;
-        check(
-            format!("pendulums.{i}.controller.b"),
-            "the damping (B·dt/(M L²))",
-            c.b * dt / inertia,
-            2.0,
-            2.0 * inertia / c.b,
-            true,
-        );
-        check(
-            format!("pendulums.{i}.controller.k"),
-            "the stiffness (K·dt²/(M L²))",
-            c.k * dt * dt / inertia,
-            4.0,
-            2.0 * (inertia / c.k).sqrt(),
+        body(
+            &format!("pendulums.{i}.controller"),
+            "(M L²)",
+            p.mass * p.length * p.length,
+            Some(("b", c.b)),
+            Some(("k", c.k)),
             true,
         );
     }
