@@ -16,6 +16,7 @@
 //! - [`run`](mod@run): a whole headless run, as the `nadf run` command does it.
 //! - [`sweep`]: parameter sweeps in parallel, with a CSV and a plot (`nadf sweep`).
 //! - [`scen`]: Moving AI scenario batches on a map world (`nadf scen`).
+//! - [`reproduce`]: the paper, claim by claim, with a verdict per claim (`nadf reproduce`).
 //! - [`cli`]: the `nadf` commands (the binary only parses and dispatches); [`output`]: writing
 //!   files whole or not at all, and checking outputs before a run.
 
@@ -28,6 +29,7 @@ pub mod field;
 pub mod metrics;
 pub mod output;
 pub mod record;
+pub mod reproduce;
 pub mod run;
 pub mod scen;
 pub mod sim;

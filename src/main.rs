@@ -4,7 +4,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use nadf::cli::{self, CheckArgs, Console, FieldArgs, RunArgs, ScenArgs, SweepArgs};
+use nadf::cli::{self, CheckArgs, Console, FieldArgs, ReproduceArgs, RunArgs, ScenArgs, SweepArgs};
 
 #[derive(Parser)]
 #[command(
@@ -33,6 +33,10 @@ enum Command {
     Scen(ScenArgs),
     /// Validate world files and print every problem found (file, line, key).
     Check(CheckArgs),
+    /// Run the paper's experiments in parallel and write `report.md` (per claim: the paper's
+    /// statement and number, the measured number, the verdict), `report.json` and one PNG per
+    /// figure.
+    Reproduce(ReproduceArgs),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +48,7 @@ fn main() -> ExitCode {
         Command::Sweep(args) => cli::sweep(args, &console),
         Command::Scen(args) => cli::scen(args, &console),
         Command::Check(args) => cli::check(args),
+        Command::Reproduce(args) => cli::reproduce(args, &console),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

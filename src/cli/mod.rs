@@ -12,12 +12,14 @@
 
 mod check;
 mod field;
+mod reproduce;
 mod run;
 mod scen;
 mod sweep;
 
 pub use check::{CheckArgs, check};
 pub use field::{FieldArgs, field};
+pub use reproduce::{ReproduceArgs, reproduce};
 pub use run::{RunArgs, run};
 pub use scen::{ScenArgs, scen};
 pub use sweep::{SweepArgs, sweep};
