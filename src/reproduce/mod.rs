@@ -91,6 +91,7 @@ pub const WORLDS: &[(&str, &str)] = &[
         "swap-viscous.toml",
         include_str!("../../worlds/swap-viscous.toml"),
     ),
+    ("crowd.toml", include_str!("../../worlds/crowd.toml")),
     ("pendulum.toml", include_str!("../../worlds/pendulum.toml")),
     (
         "pendulum-bias.toml",

@@ -25,6 +25,8 @@ pub struct ClaimReport {
     pub quantity: &'static str,
     /// The measured number.
     pub measured: f64,
+    /// Measured over the paper's number, where the paper gives one.
+    pub ratio: Option<f64>,
     /// The relation the paper's statement asks, as text.
     pub paper_relation: String,
     /// The verdict.
@@ -65,6 +67,7 @@ pub fn build(claims: &[Claim], checked: &[Checked], runs: usize, wall_time: Dura
             paper: c.paper_number,
             quantity: c.quantity,
             measured: k.measured,
+            ratio: c.paper_value.map(|p| k.measured / p),
             paper_relation: c.paper.to_string(),
             verdict: k.verdict,
             reason: if k.verdict == Verdict::Reproduced {
@@ -117,7 +120,7 @@ pub fn markdown(report: &Report, figures: &[Figure], outcomes: &Outcomes) -> Str
     );
     let _ = writeln!(
         md,
-        "| claim | paper | measured | relation | verdict |\n|---|---|---|---|---|"
+        "| claim | paper | measured | measured / paper | relation | verdict |\n|---|---|---|---|---|---|"
     );
     for c in &report.claims {
         let verdict = match c.verdict {
@@ -130,11 +133,12 @@ pub fn markdown(report: &Report, figures: &[Figure], outcomes: &Outcomes) -> Str
         };
         let _ = writeln!(
             md,
-            "| {} | {} | {} {} | {} | {} |",
+            "| {} | {} | {} {} | {} | {} | {} |",
             c.statement,
             c.paper,
             number(c.measured),
             c.quantity,
+            c.ratio.map_or("".into(), |r| format!("{r:.2}")),
             c.paper_relation,
             verdict
         );
