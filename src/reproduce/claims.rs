@@ -201,6 +201,39 @@ pub fn experiments() -> Vec<Experiment> {
             "viscous B = 0.7",
             12,
         ),
+        e(
+            "room-viscous-0.3",
+            ROOM,
+            &[
+                "duration=120",
+                "agents.0.controller.kind=\"viscous\"",
+                "agents.0.controller.b=0.3",
+            ],
+            "viscous B = 0.3",
+            12,
+        ),
+        e(
+            "room-viscous-1",
+            ROOM,
+            &[
+                "duration=120",
+                "agents.0.controller.kind=\"viscous\"",
+                "agents.0.controller.b=1",
+            ],
+            "viscous B = 1",
+            12,
+        ),
+        e(
+            "room-viscous-3",
+            ROOM,
+            &[
+                "duration=120",
+                "agents.0.controller.kind=\"viscous\"",
+                "agents.0.controller.b=3",
+            ],
+            "viscous B = 3",
+            12,
+        ),
         // The same under the paper's own law, F = −K∇V (K = 700 N·m, target disc, dt 5 ms).
         e("gradient-nadf", GRADIENT, &[], "NADF B_d = 10", 12),
         e(
@@ -311,6 +344,13 @@ pub fn experiments() -> Vec<Experiment> {
             2,
         ),
         e("sliding", "room-drift-sliding.toml", &[], "sliding mode", 2),
+        e(
+            "drift-noise",
+            "room-drift-noise.toml",
+            &[],
+            "walls sensed ±0.5 m",
+            2,
+        ),
         // §VI.6, figures 37–45: the corridor under Khatib's potential.
         e(
             "corridor-viscous-0.3",
@@ -575,6 +615,26 @@ pub fn claims() -> Vec<Claim> {
             },
         },
         Claim {
+            id: "viscous-settling-convex",
+            figure: "room-viscous-b",
+            statement: "The settling time under viscous damping is convex in B: too little swings, too much crawls (figure 23)",
+            paper_number: "a minimum inside the range",
+            paper_value: None,
+            quantity: "best settling time at B = 0.7 or 1 / best at B = 0.3 or 3",
+            runs: &[
+                "room-viscous-0.3",
+                "room-viscous-0.7",
+                "room-viscous-1",
+                "room-viscous-3",
+            ],
+            measure: |o| {
+                let inner = settle(o, "room-viscous-0.7").min(settle(o, "room-viscous-1"));
+                inner / settle(o, "room-viscous-0.3").min(settle(o, "room-viscous-3"))
+            },
+            paper: AtMost(0.9),
+            otherwise: REPRODUCED,
+        },
+        Claim {
             id: "gradient-nadf-faster",
             figure: "room-gradient",
             statement: "The same under the paper's own law F = −K∇V (K = 700 N·m, target disc 0.2 m)",
@@ -703,6 +763,38 @@ pub fn claims() -> Vec<Claim> {
                 relation: AtLeast(1.0),
                 reason: "in this room the unlimited body peaks at 6.2 m/s, so a 5 m/s cap bites only briefly",
             },
+        },
+        Claim {
+            id: "speed-limit-effort",
+            figure: "speed-limit",
+            statement: "… and lowers the control effort (figures 19–22)",
+            paper_number: "lower peak force",
+            paper_value: None,
+            quantity: "peak control force with / without the limit",
+            runs: &["speed-limit", "speed-unlimited"],
+            measure: |o| {
+                summary(o, "speed-limit").peak_force / summary(o, "speed-unlimited").peak_force
+            },
+            paper: AtMost(0.9),
+            otherwise: REPRODUCED,
+        },
+        Claim {
+            id: "drift-noise",
+            figure: "clamp",
+            statement: "With the walls sensed through noise the robot still reaches its target without collision (figures 34–36)",
+            paper_number: "no collision",
+            paper_value: None,
+            quantity: "contacts, walls sensed ±0.5 m at 10 Hz, drift and clamp",
+            runs: &["drift-noise"],
+            measure: |o| {
+                if summary(o, "drift-noise").reached {
+                    contacts(o, "drift-noise")
+                } else {
+                    f64::INFINITY
+                }
+            },
+            paper: AtMost(0.0),
+            otherwise: REPRODUCED,
         },
         Claim {
             id: "clamp-rest",
@@ -991,6 +1083,18 @@ pub fn figures() -> Vec<Figure> {
             ]),
         ),
         f(
+            "room-viscous-b",
+            "Figure 23: settling time against viscous damping B (normalized guidance)",
+            Panel::Settling(&[
+                "room-viscous-0.1",
+                "room-viscous-0.15",
+                "room-viscous-0.3",
+                "room-viscous-0.7",
+                "room-viscous-1",
+                "room-viscous-3",
+            ]),
+        ),
+        f(
             "room-gradient",
             "The room under the paper's own law F = −K∇V (K = 700 N·m)",
             Panel::Paths(&[
@@ -1018,7 +1122,7 @@ pub fn figures() -> Vec<Figure> {
         f(
             "clamp",
             "Figures 27–29: distance to the target under a constant drift",
-            Panel::Distance(&["clamp", "clamp-stiff", "bias"]),
+            Panel::Distance(&["clamp", "clamp-stiff", "bias", "drift-noise"]),
         ),
         f(
             "sliding",

@@ -26,6 +26,9 @@ pub enum Panel {
     Force(&'static [&'static str]),
     /// A pendulum's error `θ_T − θ` against time.
     Angle(&'static [&'static str]),
+    /// The settling time against the damping coefficient, one point per run (never settled:
+    /// the run's duration).
+    Settling(&'static [&'static str]),
 }
 
 /// One figure.
@@ -48,7 +51,8 @@ impl Figure {
             | Panel::Distance(r)
             | Panel::Speed(r)
             | Panel::Force(r)
-            | Panel::Angle(r) => r,
+            | Panel::Angle(r)
+            | Panel::Settling(r) => r,
         }
     }
 }
@@ -72,6 +76,17 @@ type Line = (String, usize, Vec<(f64, f64)>);
 /// One line per run (and agent) of the figure's time series or paths.
 fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
     let mut out = Vec::new();
+    if let Panel::Settling(runs) = figure.panel {
+        let points = runs
+            .iter()
+            .map(|id| {
+                let o = &outcomes[id];
+                let b = o.world.agents[0].controller.b.unwrap_or(0.0);
+                (b, o.summary().settling_time.unwrap_or(o.world.duration))
+            })
+            .collect();
+        return vec![("settling time".into(), 0, points)];
+    }
     for (colour, id) in figure.runs().iter().enumerate() {
         let o = &outcomes[id];
         let step = thin(o);
@@ -91,7 +106,7 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
                     Panel::Distance(_) => (s.time, (x - tx).hypot(y - ty)),
                     Panel::Speed(_) => (s.time, vx.hypot(vy)),
                     Panel::Force(_) => (s.time, fx.hypot(fy)),
-                    Panel::Angle(_) => unreachable!("handled above"),
+                    Panel::Angle(_) | Panel::Settling(_) => unreachable!("handled above"),
                 }
             };
             let mut points: Vec<(f64, f64)> = vec![];
@@ -200,6 +215,7 @@ pub fn draw(figure: &Figure, outcomes: &Outcomes) -> Result<Vec<u8>, String> {
                 range(&ys),
                 ("t (s)", "error θ_T − θ (rad)"),
             ),
+            Panel::Settling(_) => (range(&xs), range(&ys), ("B (N·s/m)", "settling time (s)")),
         };
         let mut chart = ChartBuilder::on(&root)
             .margin(16)

@@ -65,6 +65,10 @@ pub const WORLDS: &[(&str, &str)] = &[
         "room-drift-sliding.toml",
         include_str!("../../worlds/room-drift-sliding.toml"),
     ),
+    (
+        "room-drift-noise.toml",
+        include_str!("../../worlds/room-drift-noise.toml"),
+    ),
     ("corridor.toml", include_str!("../../worlds/corridor.toml")),
     (
         "corridor-obstruction.toml",

@@ -98,7 +98,12 @@ pub fn number(x: f64) -> String {
         return format!("{x:.0}");
     }
     let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
-    format!("{x:.digits$}")
+    let text = format!("{x:.digits$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
 }
 
 /// `report.md`, linking `FIGURE.png` for each of `figures`.
