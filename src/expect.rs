@@ -283,6 +283,10 @@ mod tests {
             lateral_speed_rms: 0.1,
             lateral_reversals: 3,
             bias_updates: 0,
+            resolves: 0,
+            intractable: None,
+            map_seen: None,
+            kinematic_length: None,
             faults: crate::metrics::Faults::default(),
         }
     }

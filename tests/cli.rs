@@ -302,7 +302,7 @@ fn field_exports_numpy_arrays_and_a_picture() {
 #[test]
 fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&str, &[&str], &[&str]); 7] = [
+    let cases: [(&str, &[&str], &[&str]); 8] = [
         (
             "room-speed-limit.toml",
             &["plots/robot/speed_limited"],
@@ -345,6 +345,16 @@ fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
             "swap.toml",
             &["agents/robot1/body", "agents/robot2/body"],
             &[],
+        ),
+        (
+            // A lidar: its rays, its map and the field re-solved on it.
+            "unknown-room.toml",
+            &[
+                "agents/robot/lidar/scan",
+                "agents/robot/lidar/map",
+                "agents/robot/field/potential",
+            ],
+            &["agents/robot/sensed_walls"],
         ),
         (
             // A map is one image; its walls are not outlined one by one.

@@ -22,7 +22,22 @@ impl GuidanceField {
     /// The field of `agent` in `world` (with the world's field kind), with `others` as
     /// obstacles besides the walls.
     pub fn build(world: &World, agent: &Agent, others: &[Disc]) -> Result<Self, FieldError> {
+        let lidar = agent
+            .sensor
+            .is_some_and(|s| s.kind == crate::world::SensorKind::Lidar);
         Ok(match world.field.kind {
+            // A lidar agent has seen nothing yet: every cell counts as free.
+            FieldKind::Harmonic if lidar => {
+                let grid = super::Grid::anchored_in(world.bounds(), world.field.cell, agent.target);
+                Self::Harmonic(HarmonicField::solve_known(
+                    world,
+                    agent,
+                    agent.start,
+                    &super::KnownMap::new(grid),
+                    others,
+                    None,
+                )?)
+            }
             FieldKind::Harmonic => Self::Harmonic(HarmonicField::solve_among(
                 world,
                 agent,

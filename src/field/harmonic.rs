@@ -19,7 +19,7 @@ use super::mask::CellCounts;
 use super::multigrid;
 use super::nested::{DEPTH_STEP, LevelStats, MAX_ITERATIONS, deep_cells, solve_levels};
 use super::scaled::{ScaledW, ldexp};
-use super::{Disc, FieldError, FreeSpace, Sampler, Streamline};
+use super::{Disc, FieldError, FreeSpace, KnownMap, Sampler, Streamline};
 use crate::control::unit;
 use crate::world::{Agent, World};
 
@@ -72,6 +72,22 @@ impl HarmonicField {
     ) -> Result<Self, FieldError> {
         let started = Instant::now();
         let space = FreeSpace::among(world, agent, position, offsets, others)?;
+        let warm = previous.map(|f| f.sampler.values().to_plain());
+        Self::solve_space(world, agent, space, warm.as_deref(), started)
+    }
+
+    /// Solves the field of a lidar agent at `position` on the map it has built (see
+    /// [`FreeSpace::known`]), warm-started from `previous`.
+    pub fn solve_known(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        known: &KnownMap,
+        others: &[Disc],
+        previous: Option<&HarmonicField>,
+    ) -> Result<Self, FieldError> {
+        let started = Instant::now();
+        let space = FreeSpace::known(world, agent, position, known, others)?;
         let warm = previous.map(|f| f.sampler.values().to_plain());
         Self::solve_space(world, agent, space, warm.as_deref(), started)
     }

@@ -5,8 +5,9 @@
 
 use super::FieldError;
 use super::grid::Grid;
+use super::known::KnownMap;
 use super::laplace;
-use crate::world::{Agent, FieldKind, WallShape, World, all_wall_shapes};
+use crate::world::{Agent, FieldKind, SensorKind, WallShape, World, all_wall_shapes};
 
 /// Another agent's disc, seen as an obstacle.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,6 +80,66 @@ impl FreeSpace {
                 .map(Disc::shape),
         );
         let blocked = rasterize(&grid, world.bounds(), &walls, agent.radius, offsets);
+        Self::from_mask(grid, blocked, agent, position)
+    }
+
+    /// The free space of a lidar agent at `position`: the box's edges, the discs `others`, and
+    /// the cells `known` believes occupied grown by the agent's radius (plus half a cell: an
+    /// occupied cell's centre can be that far inside the wall it saw). Cells never seen are
+    /// free. The cells under the agent itself are left free, so a reading that puts a wall
+    /// at its skin cannot cut it off its own field.
+    pub fn known(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        known: &KnownMap,
+        others: &[Disc],
+    ) -> Result<Self, FieldError> {
+        let grid = *known.grid();
+        let discs: Vec<_> = others.iter().map(Disc::shape).collect();
+        let mut blocked = rasterize(&grid, world.bounds(), &discs, agent.radius, &[]);
+        let grow = agent.radius + 0.5 * grid.cell;
+        let reach = (grow / grid.cell).ceil() as isize;
+        let stamp: Vec<(isize, isize)> = (-reach..=reach)
+            .flat_map(|dj| (-reach..=reach).map(move |di| (di, dj)))
+            .filter(|&(di, dj)| ((di * di + dj * dj) as f64).sqrt() * grid.cell <= grow)
+            .collect();
+        let occupied = known.occupied();
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                if !occupied[grid.index(i, j)] {
+                    continue;
+                }
+                for &(di, dj) in &stamp {
+                    let (a, b) = (i as isize + di, j as isize + dj);
+                    if a >= 0 && b >= 0 && (a as usize) < grid.nx && (b as usize) < grid.ny {
+                        blocked[grid.index(a as usize, b as usize)] = true;
+                    }
+                }
+            }
+        }
+        if let Some((ci, cj)) = grid.cell_of(position) {
+            for &(di, dj) in &stamp {
+                let (a, b) = (ci as isize + di, cj as isize + dj);
+                if a >= 0 && b >= 0 && (a as usize) < grid.nx && (b as usize) < grid.ny {
+                    let [x, y] = grid.center(a as usize, b as usize);
+                    if (x - position[0]).hypot(y - position[1]) < agent.radius {
+                        blocked[grid.index(a as usize, b as usize)] = false;
+                    }
+                }
+            }
+        }
+        Self::from_mask(grid, blocked, agent, position)
+    }
+
+    /// The free space of the mask `blocked` on `grid`: the target's cell, the cells connected
+    /// to it and the target disc, checked to connect to `position`.
+    fn from_mask(
+        grid: Grid,
+        blocked: Vec<bool>,
+        agent: &Agent,
+        position: [f64; 2],
+    ) -> Result<Self, FieldError> {
         let target_cell = grid
             .cell_of(agent.target)
             .filter(|&(i, j)| !blocked[grid.index(i, j)])
@@ -130,9 +191,11 @@ impl FreeSpace {
         if world.field.kind != FieldKind::Harmonic {
             return Vec::new();
         }
+        // A lidar agent plans on what it sees: it finds an enclosed target out online.
         world
             .agents
             .iter()
+            .filter(|a| !a.sensor.is_some_and(|s| s.kind == SensorKind::Lidar))
             .filter_map(|agent| Self::of(world, agent).err())
             .collect()
     }

@@ -77,6 +77,17 @@ crate::measured! {
         /// Updates of the iterative bias β (eq. 49) that changed it by more than
         /// `control::CONVERGED` of its size; zero without the bias option.
         pub bias_updates: usize [column("updates")],
+        /// Successful re-solves of the harmonic field (sensor readings, replans, lidar map
+        /// changes); the first solve is not counted.
+        pub resolves: usize [column("resolves")],
+        /// With a lidar: when the map it built closed every route to the target, s; `None`
+        /// otherwise.
+        pub intractable: Option<f64> [unit("s"), missing("no")],
+        /// With a lidar: the fraction of the grid's cells its scans have seen.
+        pub map_seen: Option<f64> [missing("no lidar")],
+        /// The length of the kinematic path (with full knowledge of the walls), m; `None` when
+        /// it does not reach the target.
+        pub kinematic_length: Option<f64> [unit("m"), digits(2), missing("no path")],
         /// Numerical faults met during the run (all zero in a healthy run).
         pub faults: Faults,
     }
@@ -132,6 +143,7 @@ pub struct Metrics {
     distance_at: Option<f64>,
     distance_covered: Option<f64>,
     bias_updates: usize,
+    resolves: usize,
     lateral_axis: Vector2<f64>,
     lateral_square_sum: f64,
     states: usize,
@@ -172,6 +184,7 @@ impl Metrics {
             distance_at,
             distance_covered: (distance_at == Some(0.0)).then_some(0.0),
             bias_updates: 0,
+            resolves: 0,
             lateral_axis,
             lateral_square_sum: 0.0,
             states: 0,
@@ -236,6 +249,11 @@ impl Metrics {
         self.contacts += n;
     }
 
+    /// Counts a re-solve of the harmonic field.
+    pub fn record_resolve(&mut self) {
+        self.resolves += 1;
+    }
+
     /// Counts an update of the bias β.
     pub fn record_bias_update(&mut self) {
         self.bias_updates += 1;
@@ -269,6 +287,10 @@ impl Metrics {
             final_speed: self.final_speed,
             distance_covered: self.distance_covered,
             bias_updates: self.bias_updates,
+            resolves: self.resolves,
+            intractable: None,
+            map_seen: None,
+            kinematic_length: kinematic.reached.then(|| kinematic.length()),
             lateral_speed_rms: if self.states > 0 {
                 (self.lateral_square_sum / self.states as f64).sqrt()
             } else {

@@ -47,6 +47,27 @@ pub fn table(summaries: &[Summary]) -> String {
         out += cells.join(" ").trim_end();
         out.push('\n');
     }
+    for s in summaries {
+        if let Some(t) = s.intractable {
+            out += &format!(
+                "{}: intractable at {t:.2} s: the walls it has seen close every route to its target\n",
+                s.name
+            );
+        }
+        if let Some(seen) = s.map_seen {
+            let full = s
+                .kinematic_length
+                .map_or("no path with full knowledge".into(), |l| {
+                    format!("{:.2} m with full knowledge", l)
+                });
+            out += &format!(
+                "{}: lidar saw {:.0} % of the map; path {:.2} m, {full}\n",
+                s.name,
+                100.0 * seen,
+                s.path_length
+            );
+        }
+    }
     for s in summaries.iter().filter(|s| !s.faults.is_clean()) {
         out += &format!("faults of {}: {}\n", s.name, faults(&s.faults));
     }

@@ -40,10 +40,23 @@ pub fn log_setup(
                     rerun::Scale3D::from([grid.cell as f32, grid.cell as f32, 1.0]),
                 ),
             )?;
-            rec.log_static(
-                paths.potential.as_str(),
-                &rerun::Image::from_rgb24(image, resolution).with_draw_order(-10.0),
-            )?;
+            if run.lidar.is_some() {
+                // It changes as the map grows: logged on the timeline (log_lidar).
+                let step = lidar_stride(&grid);
+                let scale = (grid.cell * step as f64) as f32;
+                rec.log_static(
+                    paths.known_map.as_str(),
+                    &rerun::Transform3D::from_translation_scale(
+                        [grid.origin[0] as f32, grid.origin[1] as f32, 0.0],
+                        rerun::Scale3D::from([scale, scale, 1.0]),
+                    ),
+                )?;
+            } else {
+                rec.log_static(
+                    paths.potential.as_str(),
+                    &rerun::Image::from_rgb24(image, resolution).with_draw_order(-10.0),
+                )?;
+            }
         }
         let (origins, vectors) = guidance_arrows(sim, run);
         rec.log_static(
@@ -132,6 +145,76 @@ impl Trails {
     }
 }
 
+/// Cells per pixel of a lidar agent's map image: at most [`LIDAR_IMAGE`] pixels a side.
+fn lidar_stride(grid: &crate::field::Grid) -> usize {
+    grid.nx.max(grid.ny).div_ceil(LIDAR_IMAGE).max(1)
+}
+
+/// The largest side of a lidar agent's map image, pixels (the image is re-logged as the map
+/// grows, so it is kept small).
+const LIDAR_IMAGE: usize = 200;
+/// Scans between two logs of the map and the field (at 10 Hz: once a second).
+const LIDAR_IMAGE_EVERY: usize = 10;
+/// Rays of a scan shown (evenly picked).
+const LIDAR_RAYS_SHOWN: usize = 90;
+
+/// A lidar agent's latest scan, and every [`LIDAR_IMAGE_EVERY`] scans its map (occupied black,
+/// free translucent white, unknown clear) and the field it now follows.
+fn log_lidar(
+    rec: &RecordingStream,
+    paths: &AgentPaths,
+    run: &AgentRun,
+    state: &AgentState,
+) -> Result<(), rerun::RecordingStreamError> {
+    let (Some(lidar), Some(beams)) = (&run.lidar, &state.scan) else {
+        return Ok(());
+    };
+    let every = beams.len().div_ceil(LIDAR_RAYS_SHOWN).max(1);
+    let rays: Vec<[[f32; 2]; 2]> = beams
+        .iter()
+        .step_by(every)
+        .map(|b| [f32x2(b.from), f32x2(b.to)])
+        .collect();
+    rec.log(
+        paths.scan.as_str(),
+        &rerun::LineStrips2D::new(rays)
+            .with_radii([0.01])
+            .with_colors([palette::rerun_alpha(palette::SENSED, palette::SENSED_ALPHA)]),
+    )?;
+    if (lidar.lidar.scans - 1) % LIDAR_IMAGE_EVERY != 0 {
+        return Ok(());
+    }
+    let grid = *lidar.map.grid();
+    let step = lidar_stride(&grid);
+    let (w, h) = (grid.nx.div_ceil(step), grid.ny.div_ceil(step));
+    let mut rgba = Vec::with_capacity(w * h * 4);
+    for j in (0..grid.ny).step_by(step) {
+        for i in (0..grid.nx).step_by(step) {
+            let k = grid.index(i, j);
+            let pixel = if lidar.map.occupied()[k] {
+                [0, 0, 0, 255]
+            } else if lidar.map.seen()[k] {
+                [255, 255, 255, 60]
+            } else {
+                [0, 0, 0, 0]
+            };
+            rgba.extend_from_slice(&pixel);
+        }
+    }
+    rec.log(
+        paths.known_map.as_str(),
+        &rerun::Image::from_rgba32(rgba, [w as u32, h as u32]).with_draw_order(-5.0),
+    )?;
+    if let Some(field) = run.field.harmonic() {
+        let (image, resolution) = colormap::potential_image(field);
+        rec.log(
+            paths.potential.as_str(),
+            &rerun::Image::from_rgb24(image, resolution).with_draw_order(-10.0),
+        )?;
+    }
+    Ok(())
+}
+
 /// The body at `p`, its arrows, contacts, events and sensed walls.
 fn log_body(
     rec: &RecordingStream,
@@ -189,6 +272,7 @@ fn log_body(
             )?;
         }
     }
+    log_lidar(rec, paths, run, state)?;
     if let Some(sensed) = &state.sensed_walls {
         rec.log(
             paths.sensed_walls.as_str(),

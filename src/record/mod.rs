@@ -12,6 +12,9 @@
 //!   and sensing problems (level INFO).
 //! - `agents/NAME/sensed_walls`: with a noisy sensor, the outline of the configuration-space
 //!   obstacles of each reading (the walls as the agent sensed them, grown by its radius).
+//! - `agents/NAME/lidar/scan` (every scan, some of its rays) and `agents/NAME/lidar/map` (once a
+//!   second at 10 Hz: occupied black, free translucent white, unknown clear): with a lidar; its
+//!   `field/potential` is then re-logged with the map, as the field is re-solved on it.
 //! - `plots/NAME/{distance, speed, radial_speed, force, force_x, force_y, potential}`: scalars.
 //! - `plots/NAME/{clamping, speed_limited}` (0 or 1) and `plots/NAME/{beta_x, beta_y}` (N):
 //!   when the agent's controller has a clamp, a speed limit or a bias.

@@ -48,6 +48,10 @@ pub struct AgentPaths {
     pub events: String,
     /// The walls as its sensor last saw them.
     pub sensed_walls: String,
+    /// The rays of its lidar's latest scan.
+    pub scan: String,
+    /// The map its lidar has built: occupied, free, unknown.
+    pub known_map: String,
 }
 
 impl AgentPaths {
@@ -67,6 +71,8 @@ impl AgentPaths {
             contacts: path("contacts"),
             events: path("events"),
             sensed_walls: path("sensed_walls"),
+            scan: path("lidar/scan"),
+            known_map: path("lidar/map"),
         }
     }
 

@@ -20,12 +20,13 @@ use nalgebra::Vector2;
 use rapier2d::prelude::{ColliderHandle, PhysicsWorld, RigidBodyHandle};
 
 use super::faults::{FaultMonitor, Observation};
+use super::lidar::Lidar;
 use super::physics::{self, from_rapier, to_rapier};
 use super::{CONTACT_TOLERANCE, Sensor, WallIndex};
 use crate::control::{ControlInput, ControlOutput, Controller, unit};
-use crate::field::{Disc, FieldError, GuidanceField, HarmonicField, Streamline};
+use crate::field::{Beam, Disc, FieldError, GuidanceField, HarmonicField, KnownMap, Streamline};
 use crate::metrics::{Metrics, Summary};
-use crate::world::{Agent, WallShape, World};
+use crate::world::{Agent, SensorKind, WallShape, World};
 
 /// One agent in a running simulation.
 pub struct AgentRun {
@@ -36,6 +37,8 @@ pub struct AgentRun {
     pub field: GuidanceField,
     /// Its wall sensor, if it senses the walls with noise.
     pub sensor: Option<Sensor>,
+    /// Its lidar and the map it builds, if it has one.
+    pub lidar: Option<LidarRun>,
     /// Its kinematic path (the streamline from its start).
     pub kinematic: Streamline,
     /// Its controller.
@@ -62,6 +65,16 @@ pub struct AgentRun {
     log: StepLog,
 }
 
+/// A lidar agent's sensor and what it knows.
+pub struct LidarRun {
+    /// The lidar.
+    pub lidar: Lidar,
+    /// The map built from its scans.
+    pub map: KnownMap,
+    /// When the known map closed every route to the target, s.
+    pub intractable_at: Option<f64>,
+}
+
 /// What one step produces for the recording, collected from `plan` to `observe`.
 #[derive(Default)]
 struct StepLog {
@@ -69,6 +82,7 @@ struct StepLog {
     events: Vec<String>,
     notes: Vec<String>,
     sensed_walls: Option<Vec<[f64; 2]>>,
+    scan: Option<Vec<Beam>>,
 }
 
 /// An agent's part of a step, read before any field is re-solved.
@@ -79,6 +93,8 @@ pub struct Plan {
     v: Vector2<f64>,
     /// Whether its sensor took a reading this step.
     sensed_now: bool,
+    /// The time at the start of the step, s.
+    time: f64,
     /// The other agents' discs.
     others: Vec<Disc>,
     /// Whether its field is rebuilt this step (a harmonic one is re-solved, in parallel).
@@ -118,6 +134,8 @@ pub struct AgentState {
     pub events: Vec<String>,
     /// Control events of this step (bias updates, sensing), as messages.
     pub notes: Vec<String>,
+    /// The lidar scan taken in this step, if any.
+    pub scan: Option<Vec<Beam>>,
 }
 
 impl AgentRun {
@@ -129,7 +147,26 @@ impl AgentRun {
         physics: &mut PhysicsWorld,
     ) -> Self {
         let agent = &world.agents[index];
-        let kinematic = field.streamline(agent.start, 4.0 * (world.size[0] + world.size[1]));
+        let length = 4.0 * (world.size[0] + world.size[1]);
+        let lidar = agent
+            .sensor
+            .filter(|s| s.kind == SensorKind::Lidar)
+            .zip(field.harmonic())
+            .map(|(settings, h)| LidarRun {
+                lidar: Lidar::new(settings, world.seed, index),
+                map: KnownMap::new(*h.grid()),
+                intractable_at: None,
+            });
+        // A lidar agent plans on what it sees; its kinematic path is the one with full
+        // knowledge of the walls (empty if the true walls enclose its target).
+        let kinematic = match (&lidar, HarmonicField::solve(world, agent)) {
+            (Some(_), Ok(full)) => full.streamline_within(agent.start, length),
+            (Some(_), Err(_)) => Streamline {
+                points: vec![agent.start],
+                reached: false,
+            },
+            (None, _) => field.streamline(agent.start, length),
+        };
         let (body, collider) = physics::insert_agent(physics, agent);
         Self {
             controller: Controller::from_settings(
@@ -142,7 +179,9 @@ impl AgentRun {
             field,
             sensor: agent
                 .sensor
+                .filter(|s| s.kind == SensorKind::Walls)
                 .map(|settings| Sensor::new(settings, world.seed, index)),
+            lidar,
             kinematic,
             faults: FaultMonitor::default(),
             body,
@@ -159,7 +198,12 @@ impl AgentRun {
 
     /// Its summary so far.
     pub fn summary(&self) -> Summary {
-        self.metrics.summary(&self.kinematic, &self.faults.faults)
+        let mut summary = self.metrics.summary(&self.kinematic, &self.faults.faults);
+        if let Some(run) = &self.lidar {
+            summary.intractable = run.intractable_at;
+            summary.map_seen = Some(run.map.seen_fraction());
+        }
+        summary
     }
 
     /// Its disc where it is now (where it last was, if Rapier's position is not finite): an
@@ -190,6 +234,7 @@ impl AgentRun {
             x,
             v,
             sensed_now: false,
+            time,
             others: Vec::new(),
             rebuild: false,
         };
@@ -211,8 +256,19 @@ impl AgentRun {
         if replan_due {
             self.replans += 1;
         }
+        let mut map_changed = false;
+        if let Some(run) = &mut self.lidar
+            && run.intractable_at.is_none()
+            && run.lidar.due(time)
+        {
+            let to_target = Vector2::from(self.agent.target) - x;
+            let heading = to_target.y.atan2(to_target.x);
+            let beams = run.lidar.scan(physics, x.into(), heading, self.collider);
+            map_changed = run.map.update(&beams);
+            self.log.scan = Some(beams);
+        }
         plan.others = others;
-        plan.rebuild = plan.sensed_now || replan_due;
+        plan.rebuild = plan.sensed_now || replan_due || map_changed;
         plan
     }
 
@@ -225,6 +281,17 @@ impl AgentRun {
         world: &World,
     ) -> Option<Result<HarmonicField, FieldError>> {
         match &self.field {
+            GuidanceField::Harmonic(field) if plan.rebuild && self.lidar.is_some() => {
+                let run = self.lidar.as_ref()?;
+                Some(HarmonicField::solve_known(
+                    world,
+                    &self.agent,
+                    plan.x.into(),
+                    &run.map,
+                    &plan.others,
+                    Some(field),
+                ))
+            }
             GuidanceField::Harmonic(field) if plan.rebuild => Some(HarmonicField::solve_among(
                 world,
                 &self.agent,
@@ -250,6 +317,15 @@ impl AgentRun {
             let (x, v) = (plan.x, plan.v);
             self.update_field(plan, solved);
             self.log.control = Some(self.control(x, v, dt));
+            if self
+                .lidar
+                .as_ref()
+                .is_some_and(|r| r.intractable_at.is_some())
+                && let Some(control) = &mut self.log.control
+            {
+                // The task is intractable on what it has seen: it stops (in one step).
+                control.force = -v * (self.agent.mass / dt);
+            }
         }
         let force = self.log.control.map_or(Vector2::zeros(), |c| c.force);
         let body = &mut physics.bodies[self.body];
@@ -304,6 +380,7 @@ impl AgentRun {
             sensed_walls: log.sensed_walls,
             events: log.events,
             notes: log.notes,
+            scan: log.scan,
         }
     }
 
@@ -335,9 +412,25 @@ impl AgentRun {
             (GuidanceField::Harmonic(field), Some(Ok(new))) => {
                 *field = new;
                 self.rebuild_failed = false;
+                self.metrics.record_resolve();
                 if plan.sensed_now {
                     self.log.sensed_walls = Some(boundary(field));
                 }
+            }
+            (GuidanceField::Harmonic(_), Some(Err(e)))
+                if self.lidar.is_some()
+                    && matches!(
+                        e,
+                        FieldError::Unreachable { .. } | FieldError::TargetBlocked { .. }
+                    ) =>
+            {
+                if let Some(run) = &mut self.lidar {
+                    run.intractable_at = Some(plan.time);
+                }
+                self.log.events.push(format!(
+                    "intractable at t = {:.2} s: the walls seen so far close every route to the target ({e}); stopping",
+                    plan.time
+                ));
             }
             (GuidanceField::Harmonic(_), Some(Err(e))) => {
                 if !self.rebuild_failed {

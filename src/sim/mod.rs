@@ -18,6 +18,7 @@
 mod agent;
 mod clearance;
 pub mod faults;
+pub mod lidar;
 pub mod pendulum;
 mod physics;
 mod sensor;
@@ -25,7 +26,7 @@ mod sensor;
 use rapier2d::prelude::PhysicsWorld;
 use rayon::prelude::*;
 
-pub use agent::{AgentRun, AgentState};
+pub use agent::{AgentRun, AgentState, LidarRun};
 pub use clearance::{WallIndex, signed_clearance};
 pub use physics::{from_rapier, to_rapier};
 pub use sensor::Sensor;
@@ -108,6 +109,11 @@ impl Simulation {
             .iter()
             .map(|p| pendulum::insert(&mut physics, p))
             .collect();
+        if agents.iter().any(|a| a.lidar.is_some()) {
+            // Rapier fills its scene-query structure during a step; a lidar scans before the
+            // first one, and would see through every wall.
+            physics.detect_collisions(&(), &());
+        }
         Ok(Self {
             world: world.clone(),
             index: WallIndex::new(&walls),

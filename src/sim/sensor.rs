@@ -84,6 +84,11 @@ mod tests {
     fn sensor(seed: u64, index: usize) -> Sensor {
         Sensor::new(
             SensorSettings {
+                kind: crate::world::SensorKind::Walls,
+                range: None,
+                rays: None,
+                fov: None,
+                dropout: None,
                 noise: 0.5,
                 position_noise: 0.0,
                 rate: 10.0,

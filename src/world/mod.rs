@@ -16,7 +16,7 @@ pub use load::{Override, WorldFile, load, load_str};
 pub use schema::{
     Agent, Attraction, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K,
     Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind, Integration, LoadedMap, MAX_CELLS,
-    MapSettings, OUTER_WALL_THICKNESS, Pendulum, PendulumController, PendulumExpect,
+    MapSettings, OUTER_WALL_THICKNESS, Pendulum, PendulumController, PendulumExpect, SensorKind,
     SensorSettings, UnknownCells, Wall, World,
 };
 pub use shapes::{

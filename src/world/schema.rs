@@ -496,12 +496,30 @@ pub struct BiasSettings {
 }
 
 /// The `[agents.sensor]` table: the agent senses the walls with noise and rebuilds its field
-/// from what it sensed.
+/// from what it sensed (`kind = "walls"`, the default), or scans with a lidar and plans on the
+/// map it builds online (`kind = "lidar"`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SensorSettings {
-    /// Half-width of the uniform noise on each wall's sensed position, m: every reading moves
-    /// each wall's boundary out or in by an independent draw from `[-noise, noise]` (default 0).
+    /// What the sensor is.
+    #[serde(default)]
+    pub kind: SensorKind,
+    /// Lidar only: the range of each ray, m (required for a lidar).
+    #[serde(default)]
+    pub range: Option<f64>,
+    /// Lidar only: rays per scan, spread evenly over the field of view (default 360).
+    #[serde(default)]
+    pub rays: Option<u32>,
+    /// Lidar only: the field of view, degrees in (0, 360], centred on the direction to the
+    /// target (default 360).
+    #[serde(default)]
+    pub fov: Option<f64>,
+    /// Lidar only: the probability that a ray returns nothing (default 0).
+    #[serde(default)]
+    pub dropout: Option<f64>,
+    /// Walls: half-width of the uniform noise on each wall's sensed position, m: every reading
+    /// moves each wall's boundary out or in by an independent draw from `[-noise, noise]`.
+    /// Lidar: the standard deviation of the Gaussian noise on each range reading, m. Default 0.
     #[serde(default)]
     pub noise: f64,
     /// Half-width of the uniform noise on the agent's estimate of its own position, m: every
@@ -511,6 +529,18 @@ pub struct SensorSettings {
     pub position_noise: f64,
     /// Readings per second; with wall noise the field is rebuilt from each reading, Hz.
     pub rate: f64,
+}
+
+/// What an agent's sensor is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SensorKind {
+    /// Every wall, each shifted by noise: the field is rebuilt from all of them.
+    #[default]
+    Walls,
+    /// A 2-D lidar of Rapier ray casts: the agent builds an occupancy map online, plans on it
+    /// (cells never seen count as free) and finds out online when its target is enclosed.
+    Lidar,
 }
 
 /// The control laws.

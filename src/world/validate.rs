@@ -4,7 +4,7 @@
 
 use super::schema::{
     Agent, Attraction, ControllerKind, ControllerSettings, Expect, FieldKind, FieldSettings,
-    GuidanceKind, Integration, MAX_CELLS, Wall, World,
+    GuidanceKind, Integration, MAX_CELLS, SensorKind, SensorSettings, Wall, World,
 };
 use super::shapes::{named_walls, wall_shape};
 
@@ -260,6 +260,68 @@ pub fn condition_40(world: &World) -> Vec<(String, String)> {
     out
 }
 
+/// A lidar's own keys: required and in range for a lidar, absent for the walls sensor.
+fn check_lidar(
+    bad: &mut impl FnMut(String, String),
+    key: &dyn Fn(&str) -> String,
+    world: &World,
+    sensor: &SensorSettings,
+) {
+    let given = [
+        ("range", sensor.range.is_some()),
+        ("rays", sensor.rays.is_some()),
+        ("fov", sensor.fov.is_some()),
+        ("dropout", sensor.dropout.is_some()),
+    ];
+    if sensor.kind == SensorKind::Walls {
+        for (name, is) in given {
+            if is {
+                bad(
+                    key(name),
+                    format!("only a lidar has `{name}` (set kind = \"lidar\")"),
+                );
+            }
+        }
+        return;
+    }
+    if world.field.kind != FieldKind::Harmonic {
+        bad(
+            key("kind"),
+            "a lidar builds a map for the harmonic field; the attractive-repulsive field is not supported".into(),
+        );
+    }
+    if sensor.position_noise != 0.0 {
+        bad(
+            key("position_noise"),
+            "a lidar's noise is on its ranges (`noise`); position noise is for the walls sensor"
+                .into(),
+        );
+    }
+    match sensor.range {
+        None => bad(key("range"), "a lidar needs `range` (m)".into()),
+        Some(r) => positive(bad, &key("range"), r),
+    }
+    if sensor.rays == Some(0) {
+        bad(key("rays"), "must be at least 1, got 0".into());
+    }
+    if let Some(fov) = sensor.fov
+        && !(fov > 0.0 && fov <= 360.0)
+    {
+        bad(
+            key("fov"),
+            format!("must be in (0, 360] degrees, got {fov}"),
+        );
+    }
+    if let Some(p) = sensor.dropout
+        && !(0.0..1.0).contains(&p)
+    {
+        bad(
+            key("dropout"),
+            format!("must be a probability in [0, 1), got {p}"),
+        );
+    }
+}
+
 fn positive(bad: &mut impl FnMut(String, String), key: &str, x: f64) {
     if !(x.is_finite() && x > 0.0) {
         bad(
@@ -485,6 +547,7 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
     positive(bad, &key("mass"), agent.mass);
     check_controller(bad, &|k| key(&format!("controller.{k}")), &agent.controller);
     if let Some(sensor) = &agent.sensor {
+        check_lidar(bad, &|k| key(&format!("sensor.{k}")), world, sensor);
         non_negative(bad, &key("sensor.noise"), sensor.noise);
         non_negative(bad, &key("sensor.position_noise"), sensor.position_noise);
         positive(bad, &key("sensor.rate"), sensor.rate);

@@ -1,0 +1,165 @@
+//! A 2-D lidar of Rapier ray casts (issue "unknown worlds"): `rays` rays over a field of view
+//! `fov` centred on the direction to the target, each cast from the agent's centre against the
+//! walls and the other agents (the query pipeline Rapier maintains), the agent's own collider
+//! excluded. Each range reading gets Gaussian noise of standard deviation `noise`, and is lost
+//! with probability `dropout`. Scans come at `rate` Hz from `t = 0`. The draws come from a
+//! SplitMix64 generator seeded by the world's seed and the agent's index, so a run is
+//! reproducible to the bit.
+
+use rapier2d::prelude::{ColliderHandle, PhysicsWorld, QueryFilter, Ray, Vector};
+
+use crate::field::Beam;
+use crate::world::SensorSettings;
+
+/// Rays per scan when the world file gives none.
+pub const DEFAULT_RAYS: u32 = 360;
+
+/// One agent's lidar.
+#[derive(Debug, Clone)]
+pub struct Lidar {
+    /// Its settings (a lidar's: `range` is set).
+    pub settings: SensorSettings,
+    state: u64,
+    /// Scans taken so far.
+    pub scans: usize,
+}
+
+impl Lidar {
+    /// The lidar of the agent at `index` in a world with `seed`.
+    pub fn new(settings: SensorSettings, seed: u64, index: usize) -> Self {
+        Self {
+            settings,
+            // Another stream than the walls sensor's for the same seed and agent.
+            state: seed ^ (index as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03),
+            scans: 0,
+        }
+    }
+
+    /// Whether a scan is due at simulated time `t`, s.
+    pub fn due(&self, t: f64) -> bool {
+        t + 1e-9 >= self.scans as f64 / self.settings.rate
+    }
+
+    /// Scans from `from` (m), facing `heading` (rad), excluding `own`: the rays that returned,
+    /// each ending at its hit or at the end of the range.
+    pub fn scan(
+        &mut self,
+        physics: &PhysicsWorld,
+        from: [f64; 2],
+        heading: f64,
+        own: ColliderHandle,
+    ) -> Vec<Beam> {
+        self.scans += 1;
+        let range = self.settings.range.unwrap_or(0.0);
+        let rays = self.settings.rays.unwrap_or(DEFAULT_RAYS).max(1);
+        let fov = self.settings.fov.unwrap_or(360.0).to_radians();
+        let dropout = self.settings.dropout.unwrap_or(0.0);
+        let filter = QueryFilter::default().exclude_collider(own);
+        let origin = Vector::new(from[0] as f32, from[1] as f32);
+        let mut beams = Vec::with_capacity(rays as usize);
+        for k in 0..rays {
+            let angle = heading - 0.5 * fov + (k as f64 + 0.5) * fov / rays as f64;
+            let (sin, cos) = angle.sin_cos();
+            let ray = Ray::new(origin, Vector::new(cos as f32, sin as f32));
+            let hit = physics
+                .cast_ray(&ray, range as f32, true, filter)
+                .map(|(_, toi)| f64::from(toi));
+            // Draw both every time, so that one ray's outcome does not shift the others' noise.
+            let (lost, noise) = (self.uniform() < dropout, self.normal());
+            if lost {
+                continue;
+            }
+            let (distance, hit) = match hit {
+                Some(d) => ((d + self.settings.noise * noise).clamp(0.0, range), true),
+                None => (range, false),
+            };
+            beams.push(Beam {
+                from,
+                to: [from[0] + distance * cos, from[1] + distance * sin],
+                hit,
+            });
+        }
+        beams
+    }
+
+    /// A standard normal draw (Box–Muller).
+    fn normal(&mut self) -> f64 {
+        let u = 1.0 - self.uniform();
+        let v = self.uniform();
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+
+    /// A uniform draw in `[0, 1)`.
+    fn uniform(&mut self) -> f64 {
+        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::world::SensorKind;
+    use rapier2d::prelude::{ColliderBuilder, RigidBodyBuilder};
+
+    fn lidar(noise: f64, dropout: f64) -> Lidar {
+        Lidar::new(
+            SensorSettings {
+                kind: SensorKind::Lidar,
+                range: Some(5.0),
+                rays: Some(4),
+                fov: None,
+                dropout: Some(dropout),
+                noise,
+                position_noise: 0.0,
+                rate: 10.0,
+            },
+            3,
+            0,
+        )
+    }
+
+    /// A wall 2 m to the right of the origin (its face at x = 1.9), nothing elsewhere.
+    fn world() -> (PhysicsWorld, ColliderHandle) {
+        let mut physics = PhysicsWorld::default();
+        let ground = physics.insert_body(RigidBodyBuilder::fixed());
+        let wall = ColliderBuilder::cuboid(0.1, 3.0).translation(Vector::new(2.0, 0.0));
+        physics.insert_collider(wall, Some(ground));
+        let (_, own) = physics.insert(RigidBodyBuilder::dynamic(), ColliderBuilder::ball(0.2));
+        physics.step();
+        (physics, own)
+    }
+
+    #[test]
+    fn rays_end_at_the_wall_or_at_the_range_and_skip_the_agent_itself() {
+        let (physics, own) = world();
+        // Four rays over 360° facing +x: at 45°, 135°, 225°, 315°.
+        let beams = lidar(0.0, 0.0).scan(&physics, [0.0, 0.0], 0.0, own);
+        assert_eq!(beams.len(), 4);
+        let hits: Vec<_> = beams.iter().filter(|b| b.hit).collect();
+        assert_eq!(hits.len(), 2, "{beams:?}");
+        for b in hits {
+            assert!((b.to[0] - 1.9).abs() < 1e-4, "{b:?}");
+        }
+        for b in beams.iter().filter(|b| !b.hit) {
+            assert!((b.to[0].hypot(b.to[1]) - 5.0).abs() < 1e-9, "{b:?}");
+        }
+    }
+
+    #[test]
+    fn noise_and_dropout_are_seeded() {
+        let (physics, own) = world();
+        let a = lidar(0.05, 0.3).scan(&physics, [0.0, 0.0], 0.0, own);
+        let b = lidar(0.05, 0.3).scan(&physics, [0.0, 0.0], 0.0, own);
+        assert_eq!(a, b);
+        let mut many = lidar(0.05, 0.3);
+        let kept: usize = (0..500)
+            .map(|_| many.scan(&physics, [0.0, 0.0], 0.0, own).len())
+            .sum();
+        // 2000 rays, 30 % lost.
+        assert!((1300..1500).contains(&kept), "{kept}");
+    }
+}
