@@ -196,6 +196,11 @@ impl AgentRun {
         }
     }
 
+    /// Its collider (a lidar excludes it from its own scans).
+    pub fn collider(&self) -> ColliderHandle {
+        self.collider
+    }
+
     /// Its summary so far.
     pub fn summary(&self) -> Summary {
         let mut summary = self.metrics.summary(&self.kinematic, &self.faults.faults);

@@ -126,6 +126,11 @@ impl Simulation {
         })
     }
 
+    /// The Rapier world, for scene queries (a lidar's ray casts).
+    pub fn physics(&self) -> &PhysicsWorld {
+        &self.physics
+    }
+
     /// Simulated time, s.
     pub fn time(&self) -> f64 {
         self.time
