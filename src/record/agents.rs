@@ -41,16 +41,19 @@ pub fn log_setup(
                 ),
             )?;
             if run.lidar.is_some() {
-                // It changes as the map grows: logged on the timeline (log_lidar).
+                // It changes as the map grows: logged on the timeline (log_lidar), with the
+                // map, at the map's resolution.
                 let step = lidar_stride(&grid);
                 let scale = (grid.cell * step as f64) as f32;
-                rec.log_static(
-                    paths.known_map.as_str(),
-                    &rerun::Transform3D::from_translation_scale(
-                        [grid.origin[0] as f32, grid.origin[1] as f32, 0.0],
-                        rerun::Scale3D::from([scale, scale, 1.0]),
-                    ),
-                )?;
+                for path in [&paths.known_map, &paths.potential] {
+                    rec.log_static(
+                        path.as_str(),
+                        &rerun::Transform3D::from_translation_scale(
+                            [grid.origin[0] as f32, grid.origin[1] as f32, 0.0],
+                            rerun::Scale3D::from([scale, scale, 1.0]),
+                        ),
+                    )?;
+                }
             } else {
                 rec.log_static(
                     paths.potential.as_str(),
@@ -58,16 +61,19 @@ pub fn log_setup(
                 )?;
             }
         }
-        let (origins, vectors) = guidance_arrows(sim, run);
-        rec.log_static(
-            paths.guidance,
-            &rerun::Arrows2D::from_vectors(vectors)
-                .with_origins(origins)
-                .with_colors([palette::rerun_alpha(
-                    palette::GUIDANCE,
-                    palette::GUIDANCE_ALPHA,
-                )]),
-        )?;
+        // A lidar agent's arrows change with its field: re-logged with it (log_lidar).
+        if run.lidar.is_none() {
+            let (origins, vectors) = guidance_arrows(sim, run);
+            rec.log_static(
+                paths.guidance,
+                &rerun::Arrows2D::from_vectors(vectors)
+                    .with_origins(origins)
+                    .with_colors([palette::rerun_alpha(
+                        palette::GUIDANCE,
+                        palette::GUIDANCE_ALPHA,
+                    )]),
+            )?;
+        }
         let path: Vec<[f32; 2]> = run.kinematic.points.iter().map(|p| f32x2(*p)).collect();
         rec.log_static(
             paths.kinematic_path,
@@ -102,6 +108,8 @@ pub fn log_setup(
 pub struct Trails {
     points: Vec<Vec<[f32; 2]>>,
     steps: usize,
+    /// Per agent, the lidar field last logged (`LidarRun::fields`).
+    fields_logged: Vec<usize>,
 }
 
 impl Trails {
@@ -110,16 +118,28 @@ impl Trails {
     pub fn log_step(
         &mut self,
         rec: &RecordingStream,
-        agents: &[AgentRun],
+        sim: &Simulation,
         states: &[AgentState],
         last: bool,
     ) -> Result<(), rerun::RecordingStreamError> {
+        let agents = &sim.agents;
         self.steps += 1;
         self.points.resize(agents.len(), Vec::new());
-        for ((run, state), trail) in agents.iter().zip(states).zip(&mut self.points) {
+        self.fields_logged.resize(agents.len(), 0);
+        for (index, ((run, state), trail)) in
+            agents.iter().zip(states).zip(&mut self.points).enumerate()
+        {
             let paths = AgentPaths::of(&run.agent.name);
             let p = f32x2(state.position.into());
             log_body(rec, &paths, run, state, p)?;
+            if let Some(lidar) = &run.lidar {
+                let due = lidar.lidar.scans % LIDAR_IMAGE_EVERY == 1;
+                let new = self.fields_logged[index] != lidar.fields;
+                if state.scan.is_some() && due && new {
+                    self.fields_logged[index] = lidar.fields;
+                }
+                log_lidar(rec, &paths, sim, run, state, due && new)?;
+            }
             for series in AGENT_SERIES.iter().filter(|s| (s.shown)(&run.agent)) {
                 rec.log(
                     plot(&run.agent.name, series.key),
@@ -152,19 +172,22 @@ fn lidar_stride(grid: &crate::field::Grid) -> usize {
 
 /// The largest side of a lidar agent's map image, pixels (the image is re-logged as the map
 /// grows, so it is kept small).
-const LIDAR_IMAGE: usize = 200;
+const LIDAR_IMAGE: usize = 128;
 /// Scans between two logs of the map and the field (at 10 Hz: once a second).
 const LIDAR_IMAGE_EVERY: usize = 10;
 /// Rays of a scan shown (evenly picked).
 const LIDAR_RAYS_SHOWN: usize = 90;
 
-/// A lidar agent's latest scan, and every [`LIDAR_IMAGE_EVERY`] scans its map (occupied black,
-/// free translucent white, unknown clear) and the field it now follows.
+/// A lidar agent's latest scan, and with `images` (every [`LIDAR_IMAGE_EVERY`] scans, when its
+/// field has been re-solved since the last ones) its map (occupied black, free translucent
+/// white, unknown clear), the field it now follows and its guidance arrows.
 fn log_lidar(
     rec: &RecordingStream,
     paths: &AgentPaths,
+    sim: &Simulation,
     run: &AgentRun,
     state: &AgentState,
+    images: bool,
 ) -> Result<(), rerun::RecordingStreamError> {
     let (Some(lidar), Some(beams)) = (&run.lidar, &state.scan) else {
         return Ok(());
@@ -181,7 +204,7 @@ fn log_lidar(
             .with_radii([0.01])
             .with_colors([palette::rerun_alpha(palette::SENSED, palette::SENSED_ALPHA)]),
     )?;
-    if (lidar.lidar.scans - 1) % LIDAR_IMAGE_EVERY != 0 {
+    if !images {
         return Ok(());
     }
     let grid = *lidar.map.grid();
@@ -206,12 +229,30 @@ fn log_lidar(
         &rerun::Image::from_rgba32(rgba, [w as u32, h as u32]).with_draw_order(-5.0),
     )?;
     if let Some(field) = run.field.harmonic() {
-        let (image, resolution) = colormap::potential_image(field);
+        let (image, [nx, ny]) = colormap::potential_image(field);
+        // At the map's resolution: this image is re-logged as the field is re-solved.
+        let mut small = Vec::with_capacity(w * h * 3);
+        for j in (0..ny as usize).step_by(step) {
+            for i in (0..nx as usize).step_by(step) {
+                let k = 3 * (j * nx as usize + i);
+                small.extend_from_slice(&image[k..k + 3]);
+            }
+        }
         rec.log(
             paths.potential.as_str(),
-            &rerun::Image::from_rgb24(image, resolution).with_draw_order(-10.0),
+            &rerun::Image::from_rgb24(small, [w as u32, h as u32]).with_draw_order(-10.0),
         )?;
     }
+    let (origins, vectors) = guidance_arrows(sim, run);
+    rec.log(
+        paths.guidance.as_str(),
+        &rerun::Arrows2D::from_vectors(vectors)
+            .with_origins(origins)
+            .with_colors([palette::rerun_alpha(
+                palette::GUIDANCE,
+                palette::GUIDANCE_ALPHA,
+            )]),
+    )?;
     Ok(())
 }
 
@@ -272,7 +313,6 @@ fn log_body(
             )?;
         }
     }
-    log_lidar(rec, paths, run, state)?;
     if let Some(sensed) = &state.sensed_walls {
         rec.log(
             paths.sensed_walls.as_str(),

@@ -129,8 +129,7 @@ impl Recorder {
         let rec = &self.stream;
         rec.set_duration_secs("sim_time", sim.time());
         pendulums::log_step(rec, &sim.pendulums)?;
-        self.trails
-            .log_step(rec, &sim.agents, states, sim.finished())?;
+        self.trails.log_step(rec, sim, states, sim.finished())?;
         if self.last_flush.elapsed() >= FLUSH_EVERY {
             // A failed flush is not fatal here: the next one, or the footer, retries.
             let _ = self.stream.flush_blocking();

@@ -73,6 +73,8 @@ pub struct LidarRun {
     pub map: KnownMap,
     /// When the known map closed every route to the target, s.
     pub intractable_at: Option<f64>,
+    /// Fields solved on the map so far (the first one counts).
+    pub fields: usize,
 }
 
 /// What one step produces for the recording, collected from `plan` to `observe`.
@@ -156,6 +158,7 @@ impl AgentRun {
                 lidar: Lidar::new(settings, world.seed, index),
                 map: KnownMap::new(*h.grid()),
                 intractable_at: None,
+                fields: 1,
             });
         // A lidar agent plans on what it sees; its kinematic path is the one with full
         // knowledge of the walls (empty if the true walls enclose its target).
@@ -418,6 +421,9 @@ impl AgentRun {
                 *field = new;
                 self.rebuild_failed = false;
                 self.metrics.record_resolve();
+                if let Some(run) = &mut self.lidar {
+                    run.fields += 1;
+                }
                 if plan.sensed_now {
                     self.log.sensed_walls = Some(boundary(field));
                 }
