@@ -63,16 +63,7 @@ pub fn log_setup(
         }
         // A lidar agent's arrows change with its field: re-logged with it (log_lidar).
         if run.lidar.is_none() {
-            let (origins, vectors) = guidance_arrows(sim, run);
-            rec.log_static(
-                paths.guidance,
-                &rerun::Arrows2D::from_vectors(vectors)
-                    .with_origins(origins)
-                    .with_colors([palette::rerun_alpha(
-                        palette::GUIDANCE,
-                        palette::GUIDANCE_ALPHA,
-                    )]),
-            )?;
+            rec.log_static(paths.guidance, &arrows(sim, run))?;
         }
         let path: Vec<[f32; 2]> = run.kinematic.points.iter().map(|p| f32x2(*p)).collect();
         rec.log_static(
@@ -243,17 +234,19 @@ fn log_lidar(
             &rerun::Image::from_rgb24(small, [w as u32, h as u32]).with_draw_order(-10.0),
         )?;
     }
-    let (origins, vectors) = guidance_arrows(sim, run);
-    rec.log(
-        paths.guidance.as_str(),
-        &rerun::Arrows2D::from_vectors(vectors)
-            .with_origins(origins)
-            .with_colors([palette::rerun_alpha(
-                palette::GUIDANCE,
-                palette::GUIDANCE_ALPHA,
-            )]),
-    )?;
+    rec.log(paths.guidance.as_str(), &arrows(sim, run))?;
     Ok(())
+}
+
+/// The guidance arrows of `run`'s current field, drawn.
+fn arrows(sim: &Simulation, run: &AgentRun) -> rerun::Arrows2D {
+    let (origins, vectors) = guidance_arrows(sim, run);
+    rerun::Arrows2D::from_vectors(vectors)
+        .with_origins(origins)
+        .with_colors([palette::rerun_alpha(
+            palette::GUIDANCE,
+            palette::GUIDANCE_ALPHA,
+        )])
 }
 
 /// The body at `p`, its arrows, contacts, events and sensed walls.

@@ -570,6 +570,14 @@ fn deviation(o: &Outcomes, id: &str) -> f64 {
     summary(o, id).max_deviation
 }
 
+/// The contacts of `touching`, or −1 when `clean` touched anything too.
+fn only_first_touches(o: &Outcomes, touching: &str, clean: &str) -> f64 {
+    if contacts(o, clean) > 0.0 {
+        return -1.0;
+    }
+    contacts(o, touching)
+}
+
 /// How many of `id`'s agents reach their targets without any contact.
 fn arrived(o: &Outcomes, id: &str) -> f64 {
     (o[id].agents.iter())
@@ -789,12 +797,7 @@ pub fn claims() -> Vec<Claim> {
             paper_value: None,
             quantity: "contacts viscous B = 0.7 − contacts NADF, from 8 m/s at a divider",
             runs: &["launch-viscous", "launch-nadf"],
-            measure: |o| {
-                if contacts(o, "launch-nadf") > 0.0 {
-                    return -1.0;
-                }
-                contacts(o, "launch-viscous")
-            },
+            measure: |o| only_first_touches(o, "launch-viscous", "launch-nadf"),
             paper: AtLeast(1.0),
             otherwise: REPRODUCED,
         },
@@ -806,12 +809,7 @@ pub fn claims() -> Vec<Claim> {
             paper_value: None,
             quantity: "contacts viscous B = 0.7 − contacts NADF, gradient guidance",
             runs: &["launch-gradient-viscous", "launch-gradient-nadf"],
-            measure: |o| {
-                if contacts(o, "launch-gradient-nadf") > 0.0 {
-                    return -1.0;
-                }
-                contacts(o, "launch-gradient-viscous")
-            },
+            measure: |o| only_first_touches(o, "launch-gradient-viscous", "launch-gradient-nadf"),
             paper: AtLeast(1.0),
             otherwise: REPRODUCED,
         },
