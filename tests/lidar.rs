@@ -91,6 +91,18 @@ fn an_enclosed_target_is_found_intractable_online() {
     common::assert_success(&run);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(stdout.contains("intractable"), "{stdout}");
+    // `nadf check` accepts the world, and says what full knowledge would have shown.
+    let check = std::process::Command::new(common::nadf_bin())
+        .arg("check")
+        .arg(common::world_path("unknown-enclosed.toml"))
+        .output()
+        .unwrap();
+    common::assert_success(&check);
+    let stdout = String::from_utf8_lossy(&check.stdout);
+    assert!(
+        stdout.contains("note: with full knowledge") && stdout.contains("find out online"),
+        "{stdout}"
+    );
 }
 
 /// With range noise and dropouts, the same seed gives the same run and another seed another.

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use super::{Failure, load};
 use crate::field::FreeSpace;
 use crate::sim::Simulation;
+use crate::world::SensorKind;
 
 /// The arguments of `nadf check`.
 #[derive(Debug, Clone, clap::Args)]
@@ -41,6 +42,20 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
                 world.agents.len(),
                 world.walls.len()
             );
+            // A lidar agent is not refused (it must find out online), but the user is told.
+            for agent in world
+                .agents
+                .iter()
+                .filter(|a| a.sensor.is_some_and(|s| s.kind == SensorKind::Lidar))
+            {
+                if let Err(e) = FreeSpace::of(&world, agent) {
+                    println!(
+                        "{}: note: with full knowledge of the walls, {e}; `{}` plans on what its lidar sees and will find out online",
+                        path.display(),
+                        agent.name
+                    );
+                }
+            }
         } else {
             problems.extend(
                 intractable
