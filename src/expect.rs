@@ -284,6 +284,7 @@ mod tests {
             lateral_reversals: 3,
             bias_updates: 0,
             resolves: 0,
+            deadlocked: None,
             intractable: None,
             map_seen: None,
             kinematic_length: None,

@@ -54,3 +54,24 @@ fn a_crowd_crosses_the_room_without_contact() {
         assert!(s.faults.is_clean(), "{s:?}");
     }
 }
+
+/// Crowds that jam are visible (issue "crowds", item 4): two robots head-on in a corridor one
+/// robot wide both end `deadlocked`, with the time (measured: 9.70 s, 5 s after they stop
+/// 0.6 m apart), and without touching; robots that pass each other are not.
+#[test]
+fn a_jam_is_reported_as_deadlocked_and_a_swap_is_not() {
+    let world = common::world("corridor-jam.toml", &[]);
+    let report = nadf::run::run(&world, &nadf::run::RunOptions::default()).unwrap();
+    for s in &report.agents {
+        let at = s.deadlocked.expect("deadlocked");
+        assert!((5.0..15.0).contains(&at), "{s:?}");
+        assert!(!s.reached && s.contacts == 0, "{s:?}");
+    }
+    for name in ["swap.toml", "crowd.toml"] {
+        let world = common::world(name, &[]);
+        let report = nadf::run::run(&world, &nadf::run::RunOptions::default()).unwrap();
+        for s in &report.agents {
+            assert_eq!(s.deadlocked, None, "{name}: {s:?}");
+        }
+    }
+}

@@ -32,6 +32,13 @@ use crate::field::Streamline;
 /// The width of the settling band, as a fraction of the initial distance to the target.
 pub const SETTLING_BAND: f64 = 0.05;
 
+/// An agent that has not come this much closer to its target (m) for [`DEADLOCK_AFTER`] seconds,
+/// while another agent is next to it, is deadlocked.
+pub const PROGRESS: f64 = 0.05;
+
+/// How long without progress makes a blocked agent deadlocked, s.
+pub const DEADLOCK_AFTER: f64 = 5.0;
+
 /// A reversal of the sideways motion counts only between excursions faster than this, m/s, so
 /// that the jitter of a body moving straight is not counted as oscillation.
 pub const LATERAL_REVERSAL_SPEED: f64 = 0.05;
@@ -77,6 +84,10 @@ crate::measured! {
         /// Updates of the iterative bias β (eq. 49) that changed it by more than
         /// `control::CONVERGED` of its size; zero without the bias option.
         pub bias_updates: usize [column("updates")],
+        /// When the agent was found deadlocked, s: no progress of [`PROGRESS`] towards its
+        /// target for [`DEADLOCK_AFTER`] seconds, outside the settling band, with another agent
+        /// within its own diameter of it; `None` otherwise.
+        pub deadlocked: Option<f64> [unit("s"), missing("no")],
         /// Successful re-solves of the harmonic field (sensor readings, replans, lidar map
         /// changes); the first solve is not counted.
         pub resolves: usize [column("resolves")],
@@ -144,6 +155,9 @@ pub struct Metrics {
     distance_covered: Option<f64>,
     bias_updates: usize,
     resolves: usize,
+    closest: f64,
+    closer_at: f64,
+    deadlocked: Option<f64>,
     lateral_axis: Vector2<f64>,
     lateral_square_sum: f64,
     states: usize,
@@ -185,6 +199,9 @@ impl Metrics {
             distance_covered: (distance_at == Some(0.0)).then_some(0.0),
             bias_updates: 0,
             resolves: 0,
+            closest: d0,
+            closer_at: 0.0,
+            deadlocked: None,
             lateral_axis,
             lateral_square_sum: 0.0,
             states: 0,
@@ -249,6 +266,20 @@ impl Metrics {
         self.contacts += n;
     }
 
+    /// Watches for a deadlock after the state of time `t` (s) was recorded; `blocked` says
+    /// whether another agent is next to this one. Returns whether it was found deadlocked now.
+    pub fn watch_progress(&mut self, t: f64, blocked: bool) -> bool {
+        if self.final_distance < self.closest - PROGRESS {
+            (self.closest, self.closer_at) = (self.final_distance, t);
+        }
+        let stuck = t - self.closer_at >= DEADLOCK_AFTER && self.final_distance > self.band;
+        if self.deadlocked.is_none() && stuck && blocked {
+            self.deadlocked = Some(t);
+            return true;
+        }
+        false
+    }
+
     /// Counts a re-solve of the harmonic field.
     pub fn record_resolve(&mut self) {
         self.resolves += 1;
@@ -288,6 +319,7 @@ impl Metrics {
             distance_covered: self.distance_covered,
             bias_updates: self.bias_updates,
             resolves: self.resolves,
+            deadlocked: self.deadlocked,
             intractable: None,
             map_seen: None,
             kinematic_length: kinematic.reached.then(|| kinematic.length()),

@@ -48,6 +48,12 @@ pub fn table(summaries: &[Summary]) -> String {
         out.push('\n');
     }
     for s in summaries {
+        if let Some(t) = s.deadlocked {
+            out += &format!(
+                "{}: deadlocked at {t:.2} s: no progress towards its target, another agent next to it\n",
+                s.name
+            );
+        }
         if let Some(t) = s.intractable {
             out += &format!(
                 "{}: intractable at {t:.2} s: the walls it has seen close every route to its target\n",

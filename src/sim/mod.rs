@@ -167,9 +167,35 @@ impl Simulation {
         }
         let walls = (self.walls.as_slice(), &self.index);
         let bounds = self.world.bounds();
-        (self.agents.iter_mut())
+        let mut states: Vec<AgentState> = (self.agents.iter_mut())
             .map(|a| a.observe(&self.physics, self.time, walls, bounds))
-            .collect()
+            .collect();
+        self.watch_deadlocks(&mut states);
+        states
+    }
+
+    /// Marks the agents that make no progress while another agent is next to them (within
+    /// their own diameter, disc to disc) as deadlocked, with an event in their state.
+    fn watch_deadlocks(&mut self, states: &mut [AgentState]) {
+        if self.agents.len() < 2 {
+            return;
+        }
+        for i in 0..self.agents.len() {
+            let r = self.agents[i].agent.radius;
+            let blocked = (0..self.agents.len()).any(|j| {
+                let gap = (states[i].position - states[j].position).norm()
+                    - r
+                    - self.agents[j].agent.radius;
+                j != i && gap < 2.0 * r
+            });
+            if self.agents[i].metrics.watch_progress(self.time, blocked) {
+                states[i].events.push(format!(
+                    "deadlocked at t = {:.2} s: no progress towards the target for {} s, another agent next to it",
+                    self.time,
+                    crate::metrics::DEADLOCK_AFTER
+                ));
+            }
+        }
     }
 
     /// Each pendulum's summary so far.
