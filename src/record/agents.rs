@@ -6,7 +6,7 @@ use rerun::RecordingStream;
 
 use super::colormap;
 use super::names::{AGENT_SERIES, AgentPaths, plot};
-use super::palette;
+use super::palette::{self, size};
 use super::world::f32x2;
 use crate::sim::{AgentRun, AgentState, Simulation};
 
@@ -70,18 +70,18 @@ pub fn log_setup(
             paths.kinematic_path,
             &rerun::LineStrips2D::new([path])
                 .with_colors([palette::rerun(palette::KINEMATIC)])
-                .with_radii([0.02]),
+                .with_radii([size::points(size::PATH)]),
         )?;
         rec.log_static(
             paths.target,
             &rerun::Points2D::new([f32x2(run.agent.target)])
-                .with_radii([0.1])
+                .with_radii([size::points(size::MARKER)])
                 .with_colors([palette::rerun(palette::TARGET)]),
         )?;
         rec.log_static(
             paths.start,
             &rerun::Points2D::new([f32x2(run.agent.start)])
-                .with_radii([0.06])
+                .with_radii([size::points(size::MARKER)])
                 .with_colors([palette::rerun(palette::START)]),
         )?;
         for series in AGENT_SERIES.iter().filter(|s| (s.shown)(&run.agent)) {
@@ -148,7 +148,7 @@ impl Trails {
                     paths.trail,
                     &rerun::LineStrips2D::new([points])
                         .with_colors([palette::rerun(palette::BODY)])
-                        .with_radii([0.015]),
+                        .with_radii([size::points(size::PATH)]),
                 )?;
             }
         }
@@ -192,7 +192,7 @@ fn log_lidar(
     rec.log(
         paths.scan.as_str(),
         &rerun::LineStrips2D::new(rays)
-            .with_radii([0.01])
+            .with_radii([size::points(size::RAY)])
             .with_colors([palette::rerun_alpha(palette::SENSED, palette::SENSED_ALPHA)]),
     )?;
     if !images {
@@ -292,7 +292,7 @@ fn log_body(
     rec.log(
         paths.contacts.as_str(),
         &rerun::Points2D::new(contacts)
-            .with_radii([0.06])
+            .with_radii([size::points(size::CONTACT)])
             .with_colors([palette::rerun(palette::CONTACT)]),
     )?;
     for (messages, level) in [
@@ -310,7 +310,7 @@ fn log_body(
         rec.log(
             paths.sensed_walls.as_str(),
             &rerun::Points2D::new(sensed.iter().map(|p| f32x2(*p)))
-                .with_radii([0.025])
+                .with_radii([size::points(size::SENSED)])
                 .with_colors([palette::rerun_alpha(palette::SENSED, palette::SENSED_ALPHA)]),
         )?;
     }

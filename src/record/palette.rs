@@ -59,3 +59,24 @@ pub fn rerun(c: Rgb) -> rerun::Color {
 pub fn rerun_alpha(c: Rgb, alpha: u8) -> rerun::Color {
     rerun::Color::from_unmultiplied_rgba(c[0], c[1], c[2], alpha)
 }
+
+/// Sizes of the marks that show where things are rather than how big they are, in UI points:
+/// they keep their size on screen at any zoom, so paths and targets stay visible on a 200 m map
+/// and do not cover a 2 m corridor. Bodies and walls keep their sizes in metres.
+pub mod size {
+    /// The radius of a mark `points` UI points wide.
+    pub fn points(points: f32) -> rerun::components::Radius {
+        rerun::components::Radius::new_ui_points(points)
+    }
+
+    /// Half-width of a path line (the kinematic path, the trail).
+    pub const PATH: f32 = 1.5;
+    /// Radius of a target or start marker.
+    pub const MARKER: f32 = 5.0;
+    /// Radius of a contact marker.
+    pub const CONTACT: f32 = 4.0;
+    /// Radius of a sensed-wall point.
+    pub const SENSED: f32 = 1.5;
+    /// Half-width of a lidar ray.
+    pub const RAY: f32 = 0.5;
+}
