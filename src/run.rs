@@ -177,6 +177,28 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
+    if let Some(r) = &mut recorder {
+        let summaries = sim.summaries();
+        let failures = crate::expect::failures(world, &summaries);
+        let mut markdown = format!("```\n{}```\n\n", metrics::table(&summaries));
+        markdown += &match (interrupted_at, failures.is_empty()) {
+            (Some(t), _) => format!("**Interrupted** at {t:.2} s.\n"),
+            (None, true) => "No expectation failed.\n".to_string(),
+            (None, false) => format!(
+                "**{} expectation(s) failed:**\n\n{}\n",
+                failures.len(),
+                failures
+                    .iter()
+                    .map(|f| format!("- {f}"))
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            ),
+        };
+        if let Err(e) = r.log_summary(&markdown) {
+            recorder.take().expect("present").abandon();
+            return Err(e.into());
+        }
+    }
     let recording = recorder.map(Recorder::finish).transpose()?;
     let report = Report {
         world: world.name().to_string(),

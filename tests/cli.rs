@@ -305,7 +305,7 @@ fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
     let cases: [(&str, &[&str], &[&str]); 8] = [
         (
             "room-speed-limit.toml",
-            &["plots/robot/speed_limited"],
+            &["plots/robot/speed_limited", "summary"],
             &["plots/robot/clamping", "plots/robot/beta_x"],
         ),
         (

@@ -5,10 +5,13 @@
 
 use rerun::blueprint::components::PlayState;
 use rerun::blueprint::{
-    Blueprint, ContainerLike, Horizontal, Spatial2DView, TimePanel, TimeSeriesView, Vertical,
+    Blueprint, ContainerLike, Horizontal, Spatial2DView, TextDocumentView, TimePanel,
+    TimeSeriesView, Vertical,
 };
 
-use super::names::{AGENT_SERIES, AGENTS, AgentPaths, PENDULUM_SERIES, Series, WORLD, plot};
+use super::names::{
+    AGENT_SERIES, AGENTS, AgentPaths, PENDULUM_SERIES, SUMMARY, Series, WORLD, plot,
+};
 use crate::world::World;
 
 /// The layout for `world`. Every agent's field image is logged, but only the first agent's is
@@ -23,6 +26,11 @@ pub fn layout(world: &World) -> Blueprint {
     views.extend(series_views(PENDULUM_SERIES, &world.pendulums, |p| {
         p.name.as_str()
     }));
+    views.push(
+        TextDocumentView::new("summary")
+            .with_origin(format!("/{SUMMARY}"))
+            .into(),
+    );
     Blueprint::new(
         Horizontal::new([
             Spatial2DView::new(world.name())

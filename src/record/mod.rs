@@ -19,6 +19,7 @@
 //! - `plots/NAME/{clamping, speed_limited}` (0 or 1) and `plots/NAME/{beta_x, beta_y}` (N):
 //!   when the agent's controller has a clamp, a speed limit or a bias.
 //!
+//! - `summary`: the run's verdict (the summary table and the expectations), a text document.
 //! - `world/pendulums/NAME/{pivot, target, rod, bob}`: a pendulum; `…/events` its bias updates
 //!   (INFO); `plots/NAME/{theta, target, torque, beta}`: θ(t), θ_T, u(t) and β(t).
 //!
@@ -136,6 +137,16 @@ impl Recorder {
             self.last_flush = std::time::Instant::now();
         }
         Ok(())
+    }
+
+    /// Logs the run's verdict (markdown: the summary table, the expectations' results) as a
+    /// static text document, shown in the layout under the plots: someone who has only the
+    /// `.rrd` sees how the run ended.
+    pub fn log_summary(&mut self, markdown: &str) -> Result<(), rerun::RecordingStreamError> {
+        self.stream.log_static(
+            names::SUMMARY,
+            &rerun::TextDocument::from_markdown(markdown),
+        )
     }
 
     /// Closes the stream (which writes the file's footer) and moves the file into place.

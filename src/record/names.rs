@@ -17,6 +17,9 @@ pub const MAP: &str = "world/map";
 /// The root of everything agents draw.
 pub const AGENTS: &str = "agents";
 
+/// The run's verdict as a text document: the summary table and the expectations' results.
+pub const SUMMARY: &str = "summary";
+
 /// The time series of `owner` (an agent or a pendulum) called `series`.
 pub fn plot(owner: &str, series: &str) -> String {
     format!("plots/{owner}/{series}")
