@@ -118,3 +118,20 @@ fn from_8_m_s_towards_a_divider_viscous_damping_hits_it_and_nadf_does_not() {
     assert!(nadf.reached && nadf.settling_time.is_some(), "{nadf:?}");
     assert!(nadf.peak_speed > 7.5, "launched at 8 m/s: {nadf:?}");
 }
+
+/// Every contact start is an event on the timeline (a WARN in the recording), one per contact
+/// the summary counts.
+#[test]
+fn every_contact_is_an_event() {
+    let world = common::world("room-two-dividers-viscous.toml", &[]);
+    let (states, s) = common::trace(&world);
+    let events = states
+        .iter()
+        .flat_map(|(_, a)| &a.events)
+        .filter(|e| e.starts_with("contact at"))
+        .count();
+    assert!(
+        s.contacts > 0 && events == s.contacts,
+        "{events} events, {s:?}"
+    );
+}

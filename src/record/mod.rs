@@ -8,8 +8,8 @@
 //! - `agents/NAME/field/guidance`: a sparse arrow field of the unit guidance `-∇V/|∇V|` (static).
 //! - `agents/NAME/kinematic_path`, `agents/NAME/target` (static).
 //! - `agents/NAME/body`, `…/trail`, `…/velocity`, `…/force`, `…/contacts`: per step.
-//! - `agents/NAME/events`: numerical faults as they start (text log, level WARN), bias updates
-//!   and sensing problems (level INFO).
+//! - `agents/NAME/events`: numerical faults and contacts as they start (text log, level WARN),
+//!   bias updates and sensing problems (level INFO).
 //! - `agents/NAME/sensed_walls`: with a noisy sensor, the outline of the configuration-space
 //!   obstacles of each reading (the walls as the agent sensed them, grown by its radius).
 //! - `agents/NAME/lidar/scan` (every scan, some of its rays) and `agents/NAME/lidar/map` (once a

@@ -132,7 +132,7 @@ pub struct AgentState {
     /// The configuration-space boundary of the walls sensed in this step (the centres of
     /// blocked cells next to free ones), m; `None` when no reading was taken.
     pub sensed_walls: Option<Vec<[f64; 2]>>,
-    /// Faults that started in this step, as messages.
+    /// Faults and contacts that started in this step, as messages.
     pub events: Vec<String>,
     /// Control events of this step (bias updates, sensing), as messages.
     pub notes: Vec<String>,
@@ -524,6 +524,15 @@ impl AgentRun {
         let started = now.difference(&self.touching).count();
         self.touching = now;
         self.metrics.record_contacts(started);
+        if started > 0 {
+            // A contact is a failure of the run: an event on the timeline, not just a mark.
+            self.log.events.push(format!(
+                "contact at [{:.3}, {:.3}] m ({} collider(s) touched now)",
+                position.x,
+                position.y,
+                self.touching.len()
+            ));
+        }
         points
     }
 }
