@@ -26,7 +26,7 @@ use super::{CONTACT_TOLERANCE, Sensor, WallIndex};
 use crate::control::{ControlInput, ControlOutput, Controller, unit};
 use crate::field::{Beam, Disc, FieldError, GuidanceField, HarmonicField, KnownMap, Streamline};
 use crate::metrics::{Metrics, Summary};
-use crate::world::{Agent, SensorKind, WallShape, World};
+use crate::world::{Agent, GuidanceKind, SensorKind, WallShape, World};
 
 /// One agent in a running simulation.
 pub struct AgentRun {
@@ -37,6 +37,9 @@ pub struct AgentRun {
     pub field: GuidanceField,
     /// Its wall sensor, if it senses the walls with noise.
     pub sensor: Option<Sensor>,
+    /// Whether its guidance is the gradient law, whose curvature the integrator uses (four
+    /// more samples of the field a step, so only then).
+    gradient_guidance: bool,
     /// Its lidar and the map it builds, if it has one.
     pub lidar: Option<LidarRun>,
     /// Its kinematic path (the streamline from its start).
@@ -162,13 +165,15 @@ impl AgentRun {
             });
         // A lidar agent plans on what it sees; its kinematic path is the one with full
         // knowledge of the walls (empty if the true walls enclose its target).
-        let kinematic = match (&lidar, HarmonicField::solve(world, agent)) {
-            (Some(_), Ok(full)) => full.streamline_within(agent.start, length),
-            (Some(_), Err(_)) => Streamline {
-                points: vec![agent.start],
-                reached: false,
+        let kinematic = match &lidar {
+            None => field.streamline(agent.start, length),
+            Some(_) => match HarmonicField::solve(world, agent) {
+                Ok(full) => full.streamline_within(agent.start, length),
+                Err(_) => Streamline {
+                    points: vec![agent.start],
+                    reached: false,
+                },
             },
-            (None, _) => field.streamline(agent.start, length),
         };
         let (body, collider) = physics::insert_agent(physics, agent);
         Self {
@@ -184,6 +189,7 @@ impl AgentRun {
                 .sensor
                 .filter(|s| s.kind == SensorKind::Walls)
                 .map(|settings| Sensor::new(settings, world.seed, index)),
+            gradient_guidance: world.field.guidance == GuidanceKind::Gradient,
             lidar,
             kinematic,
             faults: FaultMonitor::default(),
@@ -469,7 +475,10 @@ impl AgentRun {
             offset: x - Vector2::from(self.agent.target),
             velocity: v,
             gradient: self.field.gradient(x.into()),
-            curvature: self.field.curvature(x.into()),
+            curvature: self
+                .gradient_guidance
+                .then(|| self.field.curvature(x.into()))
+                .flatten(),
             dt,
             touching: !self.touching.is_empty(),
         };
