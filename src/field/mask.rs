@@ -104,28 +104,27 @@ impl FreeSpace {
             .flat_map(|dj| (-reach..=reach).map(move |di| (di, dj)))
             .filter(|&(di, dj)| ((di * di + dj * dj) as f64).sqrt() * grid.cell <= grow)
             .collect();
+        // The cells of the stamp around cell (i, j) that are on the grid.
+        let around = |i: usize, j: usize| {
+            stamp.iter().filter_map(move |&(di, dj)| {
+                let (a, b) = (i as isize + di, j as isize + dj);
+                (a >= 0 && b >= 0 && (a as usize) < grid.nx && (b as usize) < grid.ny)
+                    .then(|| grid.index(a as usize, b as usize))
+            })
+        };
         let occupied = known.occupied();
         for j in 0..grid.ny {
             for i in 0..grid.nx {
-                if !occupied[grid.index(i, j)] {
-                    continue;
-                }
-                for &(di, dj) in &stamp {
-                    let (a, b) = (i as isize + di, j as isize + dj);
-                    if a >= 0 && b >= 0 && (a as usize) < grid.nx && (b as usize) < grid.ny {
-                        blocked[grid.index(a as usize, b as usize)] = true;
-                    }
+                if occupied[grid.index(i, j)] {
+                    around(i, j).for_each(|k| blocked[k] = true);
                 }
             }
         }
         if let Some((ci, cj)) = grid.cell_of(position) {
-            for &(di, dj) in &stamp {
-                let (a, b) = (ci as isize + di, cj as isize + dj);
-                if a >= 0 && b >= 0 && (a as usize) < grid.nx && (b as usize) < grid.ny {
-                    let [x, y] = grid.center(a as usize, b as usize);
-                    if (x - position[0]).hypot(y - position[1]) < agent.radius {
-                        blocked[grid.index(a as usize, b as usize)] = false;
-                    }
+            for k in around(ci, cj) {
+                let [x, y] = grid.center(k % grid.nx, k / grid.nx);
+                if (x - position[0]).hypot(y - position[1]) < agent.radius {
+                    blocked[k] = false;
                 }
             }
         }

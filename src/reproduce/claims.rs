@@ -578,6 +578,14 @@ fn only_first_touches(o: &Outcomes, touching: &str, clean: &str) -> f64 {
     contacts(o, touching)
 }
 
+/// How many times longer `slow` takes to settle than `fast`, or 0 when either touched anything.
+fn slower_without_contact(o: &Outcomes, slow: &str, fast: &str) -> f64 {
+    if contacts(o, slow) + contacts(o, fast) > 0.0 {
+        return 0.0;
+    }
+    settle(o, slow) / settle(o, fast)
+}
+
 /// How many of `id`'s agents reach their targets without any contact.
 fn arrived(o: &Outcomes, id: &str) -> f64 {
     (o[id].agents.iter())
@@ -1093,12 +1101,7 @@ pub fn claims() -> Vec<Claim> {
             paper_value: Some(6.5),
             quantity: "settling time of robot 1, viscous / NADF",
             runs: &["swap-nadf", "swap-viscous"],
-            measure: |o| {
-                if contacts(o, "swap-nadf") + contacts(o, "swap-viscous") > 0.0 {
-                    return 0.0;
-                }
-                settle(o, "swap-viscous") / settle(o, "swap-nadf")
-            },
+            measure: |o| slower_without_contact(o, "swap-viscous", "swap-nadf"),
             paper: AtLeast(6.5),
             otherwise: Check {
                 verdict: Verdict::Weaker,
@@ -1114,12 +1117,7 @@ pub fn claims() -> Vec<Claim> {
             paper_value: Some(6.5),
             quantity: "settling time of robot 1, viscous / NADF, gradient guidance",
             runs: &["swap-gradient-nadf", "swap-gradient-viscous"],
-            measure: |o| {
-                if contacts(o, "swap-gradient-nadf") + contacts(o, "swap-gradient-viscous") > 0.0 {
-                    return 0.0;
-                }
-                settle(o, "swap-gradient-viscous") / settle(o, "swap-gradient-nadf")
-            },
+            measure: |o| slower_without_contact(o, "swap-gradient-viscous", "swap-gradient-nadf"),
             paper: AtLeast(6.5),
             otherwise: Check {
                 verdict: Verdict::Weaker,
