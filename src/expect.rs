@@ -285,6 +285,7 @@ mod tests {
             bias_updates: 0,
             resolves: 0,
             deadlocked: None,
+            min_separation: None,
             intractable: None,
             map_seen: None,
             kinematic_length: None,

@@ -109,6 +109,7 @@ impl<const N: usize> Bias<N> {
     ///         curvature: None,
     ///         dt,
     ///         touching: false,
+    ///         reference_velocity: None,
     ///     };
     ///     updated |= bias.observe(&input, &Vector1::new(u));
     ///     v += dt * (u + g) / 2.0;
@@ -170,6 +171,7 @@ mod tests {
             curvature: None,
             dt: 0.1,
             touching: false,
+            reference_velocity: None,
         }
     }
 

@@ -74,6 +74,7 @@ mod tests {
             curvature: None,
             dt: 0.01,
             touching: false,
+            reference_velocity: None,
         }
     }
 

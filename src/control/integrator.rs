@@ -184,6 +184,7 @@ impl<const N: usize> Integrator<N> {
     ///     curvature: None,
     ///     dt: 0.01,
     ///     touching: false,
+    ///     reference_velocity: None,
     /// };
     /// let f = integrator.force(&split, &input);
     /// // The velocity decays by e^{-100} over the step: the force removes it, and no more.
@@ -246,6 +247,7 @@ mod tests {
             curvature: None,
             dt,
             touching: false,
+            reference_velocity: None,
         }
     }
 
@@ -378,6 +380,7 @@ mod tests {
             curvature: None,
             dt: 0.01,
             touching: false,
+            reference_velocity: None,
         };
         let split = Split {
             explicit: Vector2::new(-1.0, 0.0),

@@ -17,6 +17,7 @@ mod clamp;
 mod guidance;
 mod integrator;
 mod nadf;
+mod orca;
 mod sliding_mode;
 mod speed_limit;
 mod spring;
@@ -27,6 +28,7 @@ pub use clamp::Clamp;
 pub use guidance::{Guidance, GuidanceMode};
 pub use integrator::{Integrator, Split, phi, positive_part};
 pub use nadf::{Nadf, step};
+pub use orca::{Neighbour, Orca, VelocityTracking};
 pub use sliding_mode::SlidingMode;
 pub use speed_limit::SpeedLimit;
 pub use spring::Spring;
@@ -72,6 +74,9 @@ pub struct ControlInput<const N: usize> {
     /// Whether the body touched something during the last step (then its change of velocity
     /// says nothing about the external force; see [`Integrator`]).
     pub touching: bool,
+    /// The velocity to track, m/s, for a law that tracks one ([`VelocityTracking`], ORCA's);
+    /// `None` for the others.
+    pub reference_velocity: Option<SVector<f64, N>>,
 }
 
 /// One term of a control law: a force from the body's state and the guidance.
@@ -222,6 +227,9 @@ impl Controller<2> {
                 f0: settings.f0.unwrap_or(0.0),
                 capture_radius: settings.capture_radius,
             })],
+            ControllerKind::Orca => vec![Box::new(VelocityTracking {
+                b: mass / settings.orca.unwrap_or_default().tracking_time,
+            })],
         };
         Self {
             laws,
@@ -263,6 +271,7 @@ mod tests {
             clamp: None,
             bias: None,
             integration: Integration::Exact,
+            orca: None,
         }
     }
 
@@ -274,6 +283,7 @@ mod tests {
             curvature: None,
             dt: 0.01,
             touching: false,
+            reference_velocity: None,
         }
     }
 

@@ -158,6 +158,7 @@ mod tests {
                 curvature: None,
                 dt: 0.01,
                 touching: false,
+                reference_velocity: None,
             };
             let split = ControlLaw::split(&nadf, &input);
             let f = split.force(&input.velocity);

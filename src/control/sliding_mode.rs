@@ -75,6 +75,7 @@ mod tests {
             curvature: None,
             dt: 0.01,
             touching: false,
+            reference_velocity: None,
         };
         assert_eq!(law().force(&input), Vector2::new(-100.0, 0.0));
         // Faster than v_d along the guidance: S flips and the law brakes.
@@ -100,6 +101,7 @@ mod tests {
             curvature: None,
             dt: 0.01,
             touching: false,
+            reference_velocity: None,
         };
         assert_eq!(law().force(&input), Vector2::new(0.0, -100.0));
     }

@@ -37,6 +37,7 @@ mod tests {
             curvature: None,
             dt: 0.01,
             touching: false,
+            reference_velocity: None,
         };
         assert_eq!(Spring { k: 20.0 }.force(&input), Vector1::new(10.0));
     }

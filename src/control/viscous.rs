@@ -46,6 +46,7 @@ mod tests {
             curvature: None,
             dt: 0.01,
             touching: false,
+            reference_velocity: None,
         };
         for g in [Some(Vector2::new(1.0, 0.0)), None] {
             assert_eq!(ControlLaw::force(&d, &input(g)), Vector2::new(-0.7, 1.4));

@@ -10,6 +10,7 @@
 //! band after band, each at its own scale and stored with its exponent ([`ScaledW`]): the
 //! field never goes flat where a path exists, however deep.
 
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector2;
@@ -19,9 +20,10 @@ use super::mask::CellCounts;
 use super::multigrid;
 use super::nested::{DEPTH_STEP, LevelStats, MAX_ITERATIONS, deep_cells, solve_levels};
 use super::scaled::{ScaledW, ldexp};
+use super::window::Window;
 use super::{Disc, FieldError, FreeSpace, KnownMap, Sampler, Streamline};
 use crate::control::unit;
-use crate::world::{Agent, World};
+use crate::world::{Agent, FieldSettings, World};
 
 /// The smallest `|∇V|` [`HarmonicField::gradient`] returns, 1/m: a gradient below it is
 /// returned at this magnitude with its direction (above `control::MIN_GRADIENT`, far below
@@ -29,12 +31,18 @@ use crate::world::{Agent, World};
 pub const GRADIENT_FLOOR: f64 = 1e-270;
 
 /// The solved field of one agent, with the statistics of the solve.
+///
+/// The grid's values and mask are shared ([`Arc`]): a local replan ([`HarmonicField::with_window`])
+/// makes a new field from the same solve of the walls and a new [`Window`] without copying them.
 #[derive(Debug, Clone)]
 pub struct HarmonicField {
-    /// The field, ready to sample.
-    pub sampler: Sampler,
+    /// The field over the whole grid, ready to sample.
+    pub sampler: Arc<Sampler>,
     /// The configuration-space mask: `true` where the agent's centre cannot be.
-    pub blocked: Vec<bool>,
+    pub blocked: Arc<Vec<bool>>,
+    /// The field re-solved around the agent with the other agents in it (local replanning);
+    /// samples inside it are read from it.
+    pub window: Option<Arc<Window>>,
     /// The target, m.
     pub target: [f64; 2],
     /// The radius of the target disc where `V = 0`, m (see [`HarmonicField::gradient`]).
@@ -115,8 +123,9 @@ impl HarmonicField {
             });
         }
         Ok(Self {
-            sampler: Sampler::new(space.grid, solution.w, space.reachable),
-            blocked: space.blocked,
+            sampler: Arc::new(Sampler::new(space.grid, solution.w, space.reachable)),
+            blocked: Arc::new(space.blocked),
+            window: None,
             target: agent.target,
             target_radius: agent.target_disc(),
             iterations: solution.iterations,
@@ -125,6 +134,73 @@ impl HarmonicField {
             relative_residual: solution.relative_residual,
             solve_time: started.elapsed(),
         })
+    }
+
+    /// This field (its walls' part) with the field re-solved in a window around `position`
+    /// with the discs `others` as obstacles (see [`Window`]): a local replan, with the window's
+    /// extent (`replan_window`, `replan_reach`) and tolerance from `settings`. The whole grid's
+    /// values are shared, not copied.
+    ///
+    /// ```
+    /// # let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/room-two-dividers.toml");
+    /// # let world = nadf::world::load(&path, &["field.cell=0.1".parse().unwrap()]).unwrap();
+    /// let agent = &world.agents[0];
+    /// let walls = nadf::field::HarmonicField::solve(&world, agent).unwrap();
+    /// // Another robot a metre down this one's guidance.
+    /// let [x, y] = agent.start;
+    /// let g = walls.gradient(agent.start).unwrap();
+    /// let ahead = [x - g.x / g.norm(), y - g.y / g.norm()];
+    /// let other = nadf::field::Disc { center: ahead, radius: 0.2 };
+    /// let replanned = walls.with_window(agent, agent.start, &[other], &world.field).unwrap();
+    /// // The guidance turns aside: no longer straight at the other robot.
+    /// let turned = replanned.gradient(agent.start).unwrap();
+    /// let cos = g.dot(&turned) / (g.norm() * turned.norm());
+    /// assert!(cos < 0.98, "{cos}");
+    /// ```
+    ///
+    /// On a field that already has a window (the last replan's, on the same walls), parts of
+    /// that one's work may be reused (its coarse window: see [`Window`]).
+    pub fn with_window(
+        &self,
+        agent: &Agent,
+        position: [f64; 2],
+        others: &[Disc],
+        settings: &FieldSettings,
+    ) -> Result<Self, FieldError> {
+        let values = (
+            self.grid(),
+            self.sampler.reachable_cells(),
+            self.sampler.values(),
+        );
+        let window = Window::solve(
+            values,
+            agent,
+            position,
+            (settings.replan_window, settings.replan_reach),
+            (others, self.window.as_deref()),
+            settings.tolerance.max(super::window::WINDOW_TOLERANCE),
+        )?;
+        Ok(Self {
+            window: Some(Arc::new(window)),
+            ..self.clone()
+        })
+    }
+
+    /// This field without its window: the field of the walls alone.
+    pub fn without_window(&self) -> Self {
+        Self {
+            window: None,
+            ..self.clone()
+        }
+    }
+
+    /// The field samples at `p` are read from: the window where it covers `p`, else the
+    /// whole grid's.
+    fn sampler_at(&self, p: [f64; 2]) -> &Sampler {
+        match &self.window {
+            Some(w) if w.covers(p) => w.sampler(),
+            _ => &self.sampler,
+        }
     }
 
     /// The grid.
@@ -139,18 +215,18 @@ impl HarmonicField {
 
     /// The potential `V` at `p` (1 where nothing reachable is near).
     pub fn potential(&self, p: [f64; 2]) -> f64 {
-        1.0 - self.sampler.w(p).unwrap_or(0.0)
+        1.0 - self.sampler_at(p).w(p).unwrap_or(0.0)
     }
 
     /// `1 - V` at `p`, with full relative precision where `V` is close to 1 (0 where it is
     /// below f64's range: see [`HarmonicField::log10_one_minus_potential`]).
     pub fn one_minus_potential(&self, p: [f64; 2]) -> f64 {
-        self.sampler.w(p).unwrap_or(0.0)
+        self.sampler_at(p).w(p).unwrap_or(0.0)
     }
 
     /// `log10(1 − V)` at `p`, at any depth (−∞ where nothing reachable is near).
     pub fn log10_one_minus_potential(&self, p: [f64; 2]) -> f64 {
-        match self.sampler.w_scaled(p) {
+        match self.sampler_at(p).w_scaled(p) {
             Some((w, e)) if w > 0.0 => (w.log2() + f64::from(e)) * std::f64::consts::LOG10_2,
             _ => f64::NEG_INFINITY,
         }
@@ -212,7 +288,7 @@ impl HarmonicField {
 
     /// The interpolated gradient of the solved cells at `p` (see [`HarmonicField::gradient`]).
     fn sampled_gradient(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
-        let (g, e) = self.sampler.grad_w_scaled(p)?;
+        let (g, e) = self.sampler_at(p).grad_w_scaled(p)?;
         let true_size = g.map(|c| ldexp(c, e));
         let size = g.norm();
         if true_size.norm() >= GRADIENT_FLOOR || !(size > 0.0 && size.is_finite()) {
@@ -350,7 +426,7 @@ mod tests {
         let grid = *field.grid();
         let reachable = field.sampler.reachable_cells().to_vec();
         let flat = ScaledW::from_plain(reachable.iter().map(|r| f64::from(u8::from(*r))).collect());
-        field.sampler = Sampler::new(grid, flat, reachable);
+        field.sampler = Arc::new(Sampler::new(grid, flat, reachable));
         let error = field.check_start(agent).unwrap_err();
         assert!(
             error.to_string().contains("no direction at its start"),

@@ -69,16 +69,7 @@ impl FreeSpace {
     ) -> Result<Self, FieldError> {
         let grid = Grid::anchored_in(world.bounds(), world.field.cell, agent.target);
         let mut walls = all_wall_shapes(world);
-        let margin = agent.radius + std::f64::consts::SQRT_2 * grid.cell;
-        let covers = |d: &Disc, p: [f64; 2]| {
-            (p[0] - d.center[0]).hypot(p[1] - d.center[1]) < d.radius + margin
-        };
-        walls.extend(
-            others
-                .iter()
-                .filter(|d| !covers(d, agent.target) && !covers(d, position))
-                .map(Disc::shape),
-        );
+        walls.extend(obstacle_discs(agent, position, grid.cell, others).map(|d| d.shape()));
         let blocked = rasterize(&grid, world.bounds(), &walls, agent.radius, offsets);
         Self::from_mask(grid, blocked, agent, position)
     }
@@ -198,6 +189,23 @@ impl FreeSpace {
             .filter_map(|agent| Self::of(world, agent).err())
             .collect()
     }
+}
+
+/// The discs of `others` that are obstacles for `agent` at `position` on a grid of `cell`
+/// metres: all but those that cover its target or itself (see [`FreeSpace::among`]).
+pub fn obstacle_discs<'a>(
+    agent: &'a Agent,
+    position: [f64; 2],
+    cell: f64,
+    others: &'a [Disc],
+) -> impl Iterator<Item = &'a Disc> + 'a {
+    let margin = agent.radius + std::f64::consts::SQRT_2 * cell;
+    let covers = move |d: &Disc, p: [f64; 2]| {
+        (p[0] - d.center[0]).hypot(p[1] - d.center[1]) < d.radius + margin
+    };
+    others
+        .iter()
+        .filter(move |d| !covers(d, agent.target) && !covers(d, position))
 }
 
 /// The `reachable` cells whose centres are within `radius` of `center` (the cell of `center`

@@ -35,6 +35,7 @@ mod nested;
 mod sample;
 mod scaled;
 mod streamline;
+mod window;
 
 pub use firas::AttractiveRepulsive;
 pub use grid::Grid;
@@ -46,6 +47,7 @@ pub use nested::LevelStats;
 pub use sample::Sampler;
 pub use scaled::ScaledW;
 pub use streamline::Streamline;
+pub use window::Window;
 
 /// The solver's internals, public for the benchmarks only: not part of the crate's API.
 #[doc(hidden)]

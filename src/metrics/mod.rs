@@ -88,6 +88,9 @@ crate::measured! {
         /// target for [`DEADLOCK_AFTER`] seconds, outside the settling band, with another agent
         /// within its own diameter of it; `None` otherwise.
         pub deadlocked: Option<f64> [unit("s"), missing("no")],
+        /// Smallest gap between the agent's disc and another agent's over the run, m
+        /// (negative: they overlapped); `None` for an agent alone.
+        pub min_separation: Option<f64> [unit("m"), missing("alone")],
         /// Successful re-solves of the harmonic field (sensor readings, replans, lidar map
         /// changes); the first solve is not counted.
         pub resolves: usize [column("resolves")],
@@ -158,6 +161,7 @@ pub struct Metrics {
     closest: f64,
     closer_at: f64,
     deadlocked: Option<f64>,
+    min_separation: Option<f64>,
     lateral_axis: Vector2<f64>,
     lateral_square_sum: f64,
     states: usize,
@@ -202,6 +206,7 @@ impl Metrics {
             closest: d0,
             closer_at: 0.0,
             deadlocked: None,
+            min_separation: None,
             lateral_axis,
             lateral_square_sum: 0.0,
             states: 0,
@@ -266,6 +271,11 @@ impl Metrics {
         self.contacts += n;
     }
 
+    /// Records the gap between the agent's disc and the nearest other agent's after a step, m.
+    pub fn record_separation(&mut self, gap: f64) {
+        self.min_separation = Some(self.min_separation.map_or(gap, |s| s.min(gap)));
+    }
+
     /// Watches for a deadlock after the state of time `t` (s) was recorded; `blocked` says
     /// whether another agent is next to this one. Returns whether it was found deadlocked now.
     pub fn watch_progress(&mut self, t: f64, blocked: bool) -> bool {
@@ -320,6 +330,7 @@ impl Metrics {
             bias_updates: self.bias_updates,
             resolves: self.resolves,
             deadlocked: self.deadlocked,
+            min_separation: self.min_separation,
             intractable: None,
             map_seen: None,
             kinematic_length: kinematic.reached.then(|| kinematic.length()),

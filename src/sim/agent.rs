@@ -23,10 +23,10 @@ use super::faults::{FaultMonitor, Observation};
 use super::lidar::Lidar;
 use super::physics::{self, from_rapier, to_rapier};
 use super::{CONTACT_TOLERANCE, Sensor, WallIndex};
-use crate::control::{ControlInput, ControlOutput, Controller, unit};
+use crate::control::{ControlInput, ControlOutput, Controller, Neighbour, Orca, unit};
 use crate::field::{Beam, Disc, FieldError, GuidanceField, HarmonicField, KnownMap, Streamline};
 use crate::metrics::{Metrics, Summary};
-use crate::world::{Agent, GuidanceKind, SensorKind, WallShape, World};
+use crate::world::{Agent, ControllerKind, GuidanceKind, Replan, SensorKind, WallShape, World};
 
 /// One agent in a running simulation.
 pub struct AgentRun {
@@ -35,6 +35,9 @@ pub struct AgentRun {
     /// Its guidance field: of the true walls, or of the last sensed walls with a sensor (and
     /// the other agents where they were at the last replan).
     pub field: GuidanceField,
+    /// With local replanning: its harmonic field of the walls alone, which every replan's
+    /// window is solved on.
+    walls: Option<HarmonicField>,
     /// Its wall sensor, if it senses the walls with noise.
     pub sensor: Option<Sensor>,
     /// Whether its guidance is the gradient law, whose curvature the integrator uses (four
@@ -46,6 +49,8 @@ pub struct AgentRun {
     pub kinematic: Streamline,
     /// Its controller.
     pub controller: Controller<2>,
+    /// ORCA, when its controller is `orca`: the velocity its controller tracks.
+    pub orca: Option<Orca>,
     /// Its metrics so far.
     pub metrics: Metrics,
     /// Its numerical faults so far.
@@ -102,8 +107,19 @@ pub struct Plan {
     time: f64,
     /// The other agents' discs.
     others: Vec<Disc>,
+    /// The other agents with their velocities, for ORCA (empty for the other controllers).
+    neighbours: Vec<Neighbour>,
     /// Whether its field is rebuilt this step (a harmonic one is re-solved, in parallel).
     rebuild: bool,
+    /// Whether what the walls' part of the field is solved from changed (a sensor reading,
+    /// the lidar's map), so a local replan must re-solve that part too.
+    walls_changed: bool,
+}
+
+/// A re-solved field, and the field of the walls it was solved on when that was re-solved too.
+pub struct Replanned {
+    field: HarmonicField,
+    walls: Option<HarmonicField>,
 }
 
 /// What happened to one agent in the last step, for recording.
@@ -144,11 +160,12 @@ pub struct AgentState {
 }
 
 impl AgentRun {
-    /// Puts the agent at `index` of `world` into `physics`, guided by `field`.
+    /// Puts the agent at `index` of `world` into `physics`, guided by `field` (with local
+    /// replanning, on the field of the `walls` alone).
     pub(super) fn new(
         world: &World,
         index: usize,
-        field: GuidanceField,
+        (field, walls): (GuidanceField, Option<HarmonicField>),
         physics: &mut PhysicsWorld,
     ) -> Self {
         let agent = &world.agents[index];
@@ -182,8 +199,18 @@ impl AgentRun {
                 world.field.guidance,
                 agent.mass,
             ),
+            orca: (agent.controller.kind == ControllerKind::Orca).then(|| {
+                let settings = agent.controller.orca.unwrap_or_default();
+                Orca {
+                    max_speed: agent.controller.speed_limit.unwrap_or(0.0),
+                    time_horizon: settings.time_horizon,
+                    neighbour_distance: settings.neighbour_distance,
+                    capture_radius: agent.controller.capture_radius,
+                }
+            }),
             metrics: Metrics::new(&agent.name, agent.start, agent.target, world.distance_at),
             agent: agent.clone(),
+            walls,
             field,
             sensor: agent
                 .sensor
@@ -220,28 +247,28 @@ impl AgentRun {
         summary
     }
 
-    /// Its disc where it is now (where it last was, if Rapier's position is not finite): an
-    /// obstacle in the other agents' fields.
-    pub(super) fn disc(&self, physics: &PhysicsWorld) -> Disc {
-        let p = from_rapier(physics.bodies[self.body].translation());
-        Disc {
-            center: if p.iter().all(|c| c.is_finite()) {
-                p.into()
-            } else {
-                self.last_position().into()
-            },
+    /// Its disc and velocity where it is now (where it last was, at rest, if Rapier's state is
+    /// not finite): an obstacle in the other agents' fields, a neighbour for ORCA.
+    pub(super) fn body(&self, physics: &PhysicsWorld) -> Neighbour {
+        let body = &physics.bodies[self.body];
+        let (p, v) = (from_rapier(body.translation()), from_rapier(body.linvel()));
+        let finite = p.iter().chain(v.iter()).all(|c| c.is_finite());
+        Neighbour {
+            position: if finite { p } else { self.last_position() },
+            velocity: if finite { v } else { Vector2::zeros() },
             radius: self.agent.radius,
         }
     }
 
     /// Step 1: reads the state, takes a sensor reading of the `walls` if one is due at `time`
-    /// (s), and decides whether the field is rebuilt with the `others` where they are now.
+    /// (s), and decides whether the field is rebuilt with the `others` where they are now
+    /// (an ORCA agent's field has the walls only: ORCA steers it among the others).
     pub(super) fn plan(
         &mut self,
         physics: &PhysicsWorld,
         time: f64,
         (world, walls): (&World, &[WallShape]),
-        others: Vec<Disc>,
+        others: Vec<Neighbour>,
     ) -> Plan {
         let (x, v) = self.read_state(physics);
         let mut plan = Plan {
@@ -250,7 +277,9 @@ impl AgentRun {
             sensed_now: false,
             time,
             others: Vec::new(),
+            neighbours: Vec::new(),
             rebuild: false,
+            walls_changed: false,
         };
         if self.frozen {
             return plan;
@@ -265,8 +294,10 @@ impl AgentRun {
             _ => false,
         };
         let replan_hz = world.field.replan_hz;
-        let replan_due =
-            !others.is_empty() && replan_hz > 0.0 && time + 1e-9 >= self.replans as f64 / replan_hz;
+        let replan_due = self.orca.is_none()
+            && !others.is_empty()
+            && replan_hz > 0.0
+            && time + 1e-9 >= self.replans as f64 / replan_hz;
         if replan_due {
             self.replans += 1;
         }
@@ -281,56 +312,121 @@ impl AgentRun {
             map_changed = run.map.update(&beams);
             self.log.scan = Some(beams);
         }
-        plan.others = others;
-        plan.rebuild = plan.sensed_now || replan_due || map_changed;
+        if self.orca.is_some() {
+            plan.neighbours = others;
+        } else {
+            // Each other agent's disc is grown by how far it moves before the next replan, so
+            // the field keeps the agent off where the other will be, not only where it is
+            // (the disc stays clear of the agent itself).
+            // (An attractive-repulsive field sees them anew every step.)
+            let replanned = replan_hz > 0.0 && self.field.harmonic().is_some();
+            let horizon = if replanned { 1.0 / replan_hz } else { 0.0 };
+            let margin = std::f64::consts::SQRT_2 * world.field.cell;
+            plan.others = others
+                .iter()
+                .map(|n| {
+                    let room = (n.position - x).norm() - n.radius - self.agent.radius - margin;
+                    let grow = (n.velocity.norm() * horizon).min(room.max(0.0));
+                    Disc {
+                        center: n.position.into(),
+                        radius: n.radius + grow,
+                    }
+                })
+                .collect();
+        }
+        plan.walls_changed = plan.sensed_now || map_changed;
+        plan.rebuild = plan.walls_changed || replan_due;
         plan
     }
 
     /// Step 2: the harmonic field re-solved for `plan`, if it is due (warm-started from the
     /// last one); `None` when nothing is re-solved. Reads only this agent, so agents run it in
     /// parallel.
+    ///
+    /// With `field.replan = "full"` the whole field is re-solved with the others in it. With
+    /// `"local"` (the default) the field of the walls is re-solved only when they were sensed
+    /// anew, and the others go into a window around the agent ([`HarmonicField::with_window`]).
+    ///
+    /// A window cut off from the target or the field's way on (see [`HarmonicField::with_window`])
+    /// falls back to the full re-solve for that replan.
     pub(super) fn resolve(
         &self,
         plan: &Plan,
         world: &World,
-    ) -> Option<Result<HarmonicField, FieldError>> {
-        match &self.field {
-            GuidanceField::Harmonic(field) if plan.rebuild && self.lidar.is_some() => {
-                let run = self.lidar.as_ref()?;
-                Some(HarmonicField::solve_known(
-                    world,
-                    &self.agent,
-                    plan.x.into(),
-                    &run.map,
-                    &plan.others,
-                    Some(field),
-                ))
-            }
-            GuidanceField::Harmonic(field) if plan.rebuild => Some(HarmonicField::solve_among(
+    ) -> Option<Result<Replanned, FieldError>> {
+        let GuidanceField::Harmonic(field) = &self.field else {
+            return None;
+        };
+        if !plan.rebuild {
+            return None;
+        }
+        let local = world.field.replan == Replan::Local;
+        let solve = |others: &[Disc]| match &self.lidar {
+            Some(run) => HarmonicField::solve_known(
+                world,
+                &self.agent,
+                plan.x.into(),
+                &run.map,
+                others,
+                Some(field),
+            ),
+            None => HarmonicField::solve_among(
                 world,
                 &self.agent,
                 plan.x.into(),
                 &self.offsets,
-                &plan.others,
+                others,
                 Some(field),
-            )),
-            _ => None,
+            ),
+        };
+        if !local {
+            return Some(solve(&plan.others).map(|field| Replanned { field, walls: None }));
         }
+        // The field of the walls: solved again when they were sensed anew, else the one kept,
+        // with the last window (whose work the new one may reuse) if the field has one.
+        let (walls, new_walls) = match &self.walls {
+            Some(walls) if !plan.walls_changed => (
+                HarmonicField {
+                    window: field.window.clone(),
+                    ..walls.clone()
+                },
+                None,
+            ),
+            _ => match solve(&[]) {
+                Ok(walls) => (walls.clone(), Some(walls)),
+                Err(e) => return Some(Err(e)),
+            },
+        };
+        let field = if plan.others.is_empty() {
+            Ok(walls.without_window())
+        } else {
+            match walls.with_window(&self.agent, plan.x.into(), &plan.others, &world.field) {
+                // Cut off, or the way on blocked in the window: whether a detour exists beyond
+                // it (and which) only the whole field can say.
+                Err(FieldError::Unreachable { .. }) => solve(&plan.others),
+                result => result,
+            }
+        };
+        Some(field.map(|field| Replanned {
+            field,
+            walls: new_walls,
+        }))
     }
 
     /// Step 3: installs the field `solved` for `plan`, computes the control force for a step
     /// of `dt` (s) and applies it to the body.
     pub(super) fn apply(
         &mut self,
-        plan: Plan,
-        solved: Option<Result<HarmonicField, FieldError>>,
+        mut plan: Plan,
+        solved: Option<Result<Replanned, FieldError>>,
         physics: &mut PhysicsWorld,
         dt: f64,
     ) {
         if !self.frozen {
             let (x, v) = (plan.x, plan.v);
+            let neighbours = std::mem::take(&mut plan.neighbours);
             self.update_field(plan, solved);
-            self.log.control = Some(self.control(x, v, dt));
+            self.log.control = Some(self.control(x, v, dt, &neighbours));
             if self
                 .lidar
                 .as_ref()
@@ -421,10 +517,13 @@ impl AgentRun {
 
     /// Installs the re-solved harmonic field (keeping the last one, with a note, when the
     /// rebuild failed), or gives an attractive-repulsive field the new reading and the others.
-    fn update_field(&mut self, plan: Plan, solved: Option<Result<HarmonicField, FieldError>>) {
+    fn update_field(&mut self, plan: Plan, solved: Option<Result<Replanned, FieldError>>) {
         match (&mut self.field, solved) {
             (GuidanceField::Harmonic(field), Some(Ok(new))) => {
-                *field = new;
+                *field = new.field;
+                if let Some(walls) = new.walls {
+                    self.walls = Some(walls);
+                }
                 self.rebuild_failed = false;
                 self.metrics.record_resolve();
                 if let Some(run) = &mut self.lidar {
@@ -468,19 +567,38 @@ impl AgentRun {
     }
 
     /// The control force at position `x` and velocity `v`, from the current field, as the
-    /// controller sees them (the position through the sensor's position error).
-    fn control(&mut self, x: Vector2<f64>, v: Vector2<f64>, dt: f64) -> ControlOutput<2> {
+    /// controller sees them (the position through the sensor's position error); an ORCA
+    /// agent's among its `neighbours`.
+    fn control(
+        &mut self,
+        x: Vector2<f64>,
+        v: Vector2<f64>,
+        dt: f64,
+        neighbours: &[Neighbour],
+    ) -> ControlOutput<2> {
         let x = x + self.position_error;
+        let offset = x - Vector2::from(self.agent.target);
+        let gradient = self.field.gradient(x.into());
+        let reference_velocity = self.orca.map(|orca| {
+            let me = Neighbour {
+                position: x,
+                velocity: v,
+                radius: self.agent.radius,
+            };
+            let preferred = orca.preferred_velocity(gradient, offset);
+            orca.velocity(&me, preferred, neighbours, dt)
+        });
         let input = ControlInput {
-            offset: x - Vector2::from(self.agent.target),
+            offset,
             velocity: v,
-            gradient: self.field.gradient(x.into()),
+            gradient,
             curvature: self
                 .gradient_guidance
                 .then(|| self.field.curvature(x.into()))
                 .flatten(),
             dt,
             touching: !self.touching.is_empty(),
+            reference_velocity,
         };
         let mut out = self.controller.step(&input);
         // Finite in f64 but beyond f32's range is still not finite for Rapier.

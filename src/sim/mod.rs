@@ -31,9 +31,10 @@ pub use clearance::{WallIndex, signed_clearance};
 pub use physics::{from_rapier, to_rapier};
 pub use sensor::Sensor;
 
-use crate::field::{Disc, FieldError, GuidanceField};
+use crate::control::Neighbour;
+use crate::field::{Disc, FieldError, GuidanceField, HarmonicField};
 use crate::metrics::Summary;
-use crate::world::{WallShape, World, all_wall_shapes};
+use crate::world::{ControllerKind, FieldKind, Replan, WallShape, World, all_wall_shapes};
 
 /// A pair counts as touching when Rapier has an active contact between them whose distance is
 /// at most this, m. Rapier also keeps speculative contacts up to its prediction distance
@@ -90,19 +91,14 @@ impl Simulation {
                 radius: a.radius,
             })
             .collect();
+        // Every agent's first field, in parallel (each reads only its own agent).
+        let fields: Vec<Result<_, FieldError>> = (0..world.agents.len())
+            .into_par_iter()
+            .map(|index| first_field(world, index, &others_than(&starts, index)))
+            .collect();
         let mut agents = Vec::with_capacity(world.agents.len());
-        for (index, agent) in world.agents.iter().enumerate() {
-            let others = others_than(&starts, index);
-            let field = match GuidanceField::build(world, agent, &others) {
-                Err(FieldError::Unreachable { .. }) if !others.is_empty() => {
-                    GuidanceField::build(world, agent, &[])?
-                }
-                result => result?,
-            };
-            if let Some(harmonic) = field.harmonic() {
-                harmonic.check_start(agent)?;
-            }
-            agents.push(AgentRun::new(world, index, field, &mut physics));
+        for (index, field) in fields.into_iter().enumerate() {
+            agents.push(AgentRun::new(world, index, field?, &mut physics));
         }
         let pendulums = world
             .pendulums
@@ -144,10 +140,10 @@ impl Simulation {
     /// Advances one physics step and returns each agent's state after it: plan every agent,
     /// re-solve the due fields in parallel, apply the controls, step Rapier, observe.
     pub fn step(&mut self) -> Vec<AgentState> {
-        let discs: Vec<Disc> = self.agents.iter().map(|a| a.disc(&self.physics)).collect();
+        let bodies: Vec<Neighbour> = self.agents.iter().map(|a| a.body(&self.physics)).collect();
         let scene = (&self.world, self.walls.as_slice());
         let plans: Vec<_> = (self.agents.iter_mut().enumerate())
-            .map(|(i, a)| a.plan(&self.physics, self.time, scene, others_than(&discs, i)))
+            .map(|(i, a)| a.plan(&self.physics, self.time, scene, others_than(&bodies, i)))
             .collect();
         // Each re-solve reads only its own agent, so the results do not depend on the threads.
         let solved: Vec<_> = (self.agents.par_iter().zip(&plans))
@@ -170,25 +166,30 @@ impl Simulation {
         let mut states: Vec<AgentState> = (self.agents.iter_mut())
             .map(|a| a.observe(&self.physics, self.time, walls, bounds))
             .collect();
-        self.watch_deadlocks(&mut states);
+        self.watch_neighbours(&mut states);
         states
     }
 
-    /// Marks the agents that make no progress while another agent is next to them (within
-    /// their own diameter, disc to disc) as deadlocked, with an event in their state.
-    fn watch_deadlocks(&mut self, states: &mut [AgentState]) {
+    /// Records each agent's gap to the nearest other agent, and marks the agents that make no
+    /// progress while another agent is next to them (within their own diameter, disc to disc)
+    /// as deadlocked, with an event in their state.
+    fn watch_neighbours(&mut self, states: &mut [AgentState]) {
         if self.agents.len() < 2 {
             return;
         }
         for i in 0..self.agents.len() {
             let r = self.agents[i].agent.radius;
-            let blocked = (0..self.agents.len()).any(|j| {
-                let gap = (states[i].position - states[j].position).norm()
-                    - r
-                    - self.agents[j].agent.radius;
-                j != i && gap < 2.0 * r
-            });
-            if self.agents[i].metrics.watch_progress(self.time, blocked) {
+            let gap = (0..self.agents.len())
+                .filter(|&j| j != i)
+                .map(|j| {
+                    (states[i].position - states[j].position).norm()
+                        - r
+                        - self.agents[j].agent.radius
+                })
+                .fold(f64::INFINITY, f64::min);
+            let metrics = &mut self.agents[i].metrics;
+            metrics.record_separation(gap);
+            if metrics.watch_progress(self.time, gap < 2.0 * r) {
                 states[i].events.push(format!(
                     "deadlocked at t = {:.2} s: no progress towards the target for {} s, another agent next to it",
                     self.time,
@@ -212,9 +213,51 @@ impl Simulation {
     }
 }
 
-/// Every disc of `discs` but the one at `index`.
-fn others_than(discs: &[Disc], index: usize) -> Vec<Disc> {
-    discs
+/// The first field of the agent at `index` of `world`, with the discs `others` (the other
+/// agents at their starts) as obstacles: in the whole field, or with `field.replan = "local"`
+/// in a window around the agent on top of the field of the walls (which it returns too, for
+/// the replans; a window cut off there falls back to the whole field).
+///
+/// If the others cut the agent off from its target there, its first field ignores them (they
+/// will move); only a target that the walls alone make unreachable is an error. So is a start
+/// where the field gives no direction.
+fn first_field(
+    world: &World,
+    index: usize,
+    others: &[Disc],
+) -> Result<(GuidanceField, Option<HarmonicField>), FieldError> {
+    let agent = &world.agents[index];
+    let orca = agent.controller.kind == ControllerKind::Orca;
+    let local = world.field.replan == Replan::Local && world.field.kind == FieldKind::Harmonic;
+    let (field, walls) = if orca || others.is_empty() {
+        // ORCA steers it among the others: its field has the walls only.
+        let field = GuidanceField::build(world, agent, &[])?;
+        let walls = field.harmonic().filter(|_| local && !orca).cloned();
+        (field, walls)
+    } else if local {
+        let walls = GuidanceField::build(world, agent, &[])?;
+        let harmonic = walls.harmonic().expect("a harmonic field").clone();
+        let field = match harmonic.with_window(agent, agent.start, others, &world.field) {
+            Ok(windowed) => GuidanceField::Harmonic(windowed),
+            Err(_) => GuidanceField::build(world, agent, others).unwrap_or(walls),
+        };
+        (field, Some(harmonic))
+    } else {
+        let field = match GuidanceField::build(world, agent, others) {
+            Err(FieldError::Unreachable { .. }) => GuidanceField::build(world, agent, &[])?,
+            result => result?,
+        };
+        (field, None)
+    };
+    if let Some(harmonic) = field.harmonic() {
+        harmonic.check_start(agent)?;
+    }
+    Ok((field, walls))
+}
+
+/// Every item of `items` but the one at `index`.
+fn others_than<T: Copy>(items: &[T], index: usize) -> Vec<T> {
+    items
         .iter()
         .enumerate()
         .filter(|&(i, _)| i != index)

@@ -180,6 +180,7 @@ impl PendulumRun {
             curvature: None,
             dt,
             touching: false,
+            reference_velocity: None,
         };
         let out = self.controller.step(&input);
         let torque = out.force.x;

@@ -16,8 +16,8 @@ pub use load::{Override, WorldFile, load, load_str};
 pub use schema::{
     Agent, Attraction, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K,
     Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind, Integration, LoadedMap, MAX_CELLS,
-    MapSettings, OUTER_WALL_THICKNESS, Pendulum, PendulumController, PendulumExpect, SensorKind,
-    SensorSettings, UnknownCells, Wall, World,
+    MapSettings, OUTER_WALL_THICKNESS, OrcaSettings, Pendulum, PendulumController, PendulumExpect,
+    Replan, SensorKind, SensorSettings, UnknownCells, Wall, World,
 };
 pub use shapes::{
     WallShape, all_wall_shapes, all_walls, drawn_walls, named_walls, outer_walls, wall_shape,

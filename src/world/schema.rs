@@ -195,6 +195,19 @@ pub struct FieldSettings {
     /// from the last one; an attractive-repulsive one sees the others at every step regardless.
     #[serde(default = "default_replan_hz")]
     pub replan_hz: f64,
+    /// With several agents and a harmonic field: what a replan re-solves.
+    #[serde(default)]
+    pub replan: Replan,
+    /// `replan = "local"`: how far the window re-solved around the agent extends from it along
+    /// x and y, m (the window is a square of twice this side). Agents farther than this are
+    /// not seen until the agent comes nearer.
+    #[serde(default = "default_replan_window")]
+    pub replan_window: f64,
+    /// `replan = "local"`: how far a coarse window (four times the cell) extends around the
+    /// agent, m: the other agents up to this far bend its guidance, and the window of
+    /// `replan_window` takes its edge from it. At most `replan_window`: no coarse window.
+    #[serde(default = "default_replan_reach")]
+    pub replan_reach: f64,
     /// `attractive-repulsive`: how the target attracts.
     #[serde(default)]
     pub attraction: Attraction,
@@ -204,6 +217,21 @@ pub struct FieldSettings {
     /// `attractive-repulsive`: the range ρ0 of the repulsion, m (required with that kind).
     #[serde(default)]
     pub rho0: Option<f64>,
+}
+
+/// What a replan of a harmonic field re-solves (`field.replan`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Replan {
+    /// The field of the walls is solved once; a replan re-solves only a window around the
+    /// agent (`field.replan_window`) with the other agents in it as obstacles, the field of
+    /// the walls holding the window's edge (`field::Window`). Costs what the window costs,
+    /// whatever the size of the world.
+    #[default]
+    Local,
+    /// Every replan re-solves the whole field with every other agent as an obstacle
+    /// (warm-started): the reference the local replan is measured against.
+    Full,
 }
 
 /// Which potential guides the agents.
@@ -239,6 +267,9 @@ impl Default for FieldSettings {
             max_cells: default_max_cells(),
             kind: FieldKind::default(),
             replan_hz: default_replan_hz(),
+            replan: Replan::default(),
+            replan_window: default_replan_window(),
+            replan_reach: default_replan_reach(),
             attraction: Attraction::default(),
             eta: None,
             rho0: None,
@@ -447,6 +478,46 @@ pub struct ControllerSettings {
     /// How the law's force is handed to the physics each step (default `exact`).
     #[serde(default)]
     pub integration: Integration,
+    /// `kind = "orca"`: ORCA's settings (defaults when absent).
+    #[serde(default)]
+    pub orca: Option<OrcaSettings>,
+}
+
+/// The `[agents.controller.orca]` table: optimal reciprocal collision avoidance's settings
+/// (see `control::Orca`). The agent's top speed is the controller's `speed_limit`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrcaSettings {
+    /// How far ahead ORCA keeps clear of the other agents, s (RVO2's examples: 2–10 s).
+    #[serde(default = "default_orca_time_horizon")]
+    pub time_horizon: f64,
+    /// Agents within this distance are ORCA's neighbours, m.
+    #[serde(default = "default_orca_neighbour_distance")]
+    pub neighbour_distance: f64,
+    /// Time constant of the force that tracks ORCA's velocity, s (the body's velocity error
+    /// decays as `e^{−t/τ}`).
+    #[serde(default = "default_orca_tracking_time")]
+    pub tracking_time: f64,
+}
+
+impl Default for OrcaSettings {
+    fn default() -> Self {
+        Self {
+            time_horizon: default_orca_time_horizon(),
+            neighbour_distance: default_orca_neighbour_distance(),
+            tracking_time: default_orca_tracking_time(),
+        }
+    }
+}
+
+fn default_orca_time_horizon() -> f64 {
+    2.0
+}
+fn default_orca_neighbour_distance() -> f64 {
+    10.0
+}
+fn default_orca_tracking_time() -> f64 {
+    0.1
 }
 
 /// How a controller's force is integrated over a physics step.
@@ -553,6 +624,10 @@ pub enum ControllerKind {
     Viscous,
     /// Guldner and Utkin's sliding mode on the guidance (eq. 72–73).
     SlidingMode,
+    /// Not the paper's: the guidance at `speed_limit` as the preferred velocity of ORCA
+    /// (optimal reciprocal collision avoidance, van den Berg et al. 2011) among the other
+    /// agents, tracked by a force (`control::Orca`). The baseline of crowds.
+    Orca,
 }
 
 impl ControllerKind {
@@ -562,6 +637,7 @@ impl ControllerKind {
             Self::Nadf => "nadf",
             Self::Viscous => "viscous",
             Self::SlidingMode => "sliding-mode",
+            Self::Orca => "orca",
         }
     }
 }
@@ -580,6 +656,12 @@ fn default_cell() -> f64 {
 }
 fn default_replan_hz() -> f64 {
     10.0
+}
+fn default_replan_window() -> f64 {
+    3.0
+}
+fn default_replan_reach() -> f64 {
+    24.0
 }
 fn default_tolerance() -> f64 {
     1e-12

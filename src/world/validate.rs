@@ -57,6 +57,17 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
     }
     check_field_kind(&mut bad, &world.field);
     non_negative(&mut bad, "field.replan_hz", world.field.replan_hz);
+    non_negative(&mut bad, "field.replan_reach", world.field.replan_reach);
+    let window = world.field.replan_window;
+    if !(window.is_finite() && window >= 3.0 * world.field.cell) {
+        bad(
+            "field.replan_window".into(),
+            format!(
+                "must be at least three cells ({} m), got {window}",
+                3.0 * world.field.cell
+            ),
+        );
+    }
     if world.dt.is_finite() && world.duration.is_finite() && world.dt > world.duration {
         bad(
             "dt".into(),
@@ -244,6 +255,8 @@ pub fn condition_40(world: &World) -> Vec<(String, String)> {
                     ));
                 }
             }
+            // ORCA tracks a velocity; it has no guidance force to compare.
+            ControllerKind::Orca => {}
             ControllerKind::SlidingMode => {
                 let f0 = c.f0.unwrap_or(0.0);
                 if f0 <= external {
@@ -370,6 +383,26 @@ fn check_controller(
             unused(&mut *bad, "k", c.k);
             unused(&mut *bad, "b", c.b);
         }
+        ControllerKind::Orca => {
+            needs(
+                &mut *bad,
+                "speed_limit",
+                c.speed_limit,
+                "ORCA's top speed, m/s",
+            );
+            unused(&mut *bad, "k", c.k);
+            unused(&mut *bad, "b", c.b);
+            unused(&mut *bad, "vd", c.vd);
+            unused(&mut *bad, "f0", c.f0);
+        }
+    }
+    if c.kind != ControllerKind::Orca && c.orca.is_some() {
+        bad(key("orca"), format!("is not used by kind = \"{kind}\""));
+    }
+    if let Some(o) = &c.orca {
+        positive(bad, &key("orca.time_horizon"), o.time_horizon);
+        positive(bad, &key("orca.neighbour_distance"), o.neighbour_distance);
+        positive(bad, &key("orca.tracking_time"), o.tracking_time);
     }
     if let Some(k) = c.k {
         positive(bad, &key("k"), k);

@@ -1,0 +1,498 @@
+//! Local replanning (`field.replan = "local"`): the part of an agent's field that the other
+//! agents change, re-solved in a square window around the agent, with the field of the walls
+//! holding the window's edge ([`Window`]).
+//!
+//! Why it is enough: the other agents are small obstacles (`W = 0` on their discs). Their effect
+//! on `W` is largest next to them and is forced to zero on the window's edge, where the field of
+//! the walls is kept; inside the window the solution is harmonic with the agents as obstacles,
+//! so it has no local maximum of `W` (a local minimum of `V`) there, and a streamline from the
+//! agent either reaches the target or leaves the window, into the field of the walls, which
+//! leads to the target. What a full re-solve adds is the others' effect beyond the window, which
+//! decays with the distance from them (measured in `tests/crowd.rs` as the angle between the two
+//! guidances along the agents' paths).
+//!
+//! Cost: the window's cells, `(2 · replan_window / cell)²` (3 721 for a 3 m window at 10 cm),
+//! however large the world: the cost per replan does not grow with the map.
+
+// The cell loops fill several arrays of one window by one index: the form that reads like the
+// problem it sets up.
+#![allow(clippy::needless_range_loop)]
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use super::grid::Grid;
+use super::mask::{Disc, disc_cells, obstacle_discs};
+use super::multigrid;
+use super::nested::{DEPTH_STEP, MAX_ITERATIONS, deep_cells, solve_levels};
+use super::scaled::{ScaledW, exponent_of, ldexp};
+use super::{FieldError, Sampler};
+use crate::world::Agent;
+
+/// The field re-solved in a window around an agent, with the other agents in it as obstacles.
+///
+/// - The window is the square of the agent's grid `replan_window` metres either side of it. Its
+///   outermost ring of cells, the target disc's cells (`W = 1`) and the cells the field of the
+///   walls does not reach (`W = 0`) are the Dirichlet data; so are the cells of the other
+///   agents' discs, grown by the agent's radius (`W = 0`).
+/// - The ring's values come from a coarse window: `replan_reach` metres either side at four
+///   times the cell, solved the same way, with the field of the walls on its own ring. So
+///   agents up to `replan_reach` away bend the guidance (a crowd ahead is gone around early).
+///   It is re-solved every fifth replan, while the agent stays within a quarter of its reach of
+///   where it was solved (the agents it shows are far and move little between replans).
+/// - Both are solved to a relative residual of 1e-9 (or the field's tolerance if looser): their
+///   difference from a full re-solve, degrees of guidance near the others, is far above what a
+///   tighter solve changes, and it takes about a third fewer iterations than 1e-12. Cells below
+///   what the solve resolves go to the nested levels, as in a full solve.
+/// - An agent that the others cut off, or whose every way on they block within the window
+///   (every ring cell it can reach has a lower `W` of the walls than it has, and no target cell),
+///   gets [`FieldError::Unreachable`]: whether a detour exists beyond the window only a full
+///   re-solve can say, and the simulation falls back to one for that replan.
+#[derive(Debug, Clone)]
+pub struct Window {
+    /// The window's cells, a part of the agent's grid.
+    sampler: Sampler,
+    /// Where samples are read from the window: the points whose interpolation stencil lies at
+    /// least one cell inside its edge (central differences there read only window cells), as
+    /// fractional cell coordinates `[lo, hi)` along x and y.
+    interior: [[f64; 2]; 2],
+    /// The other agents that were inside the window, as obstacles.
+    pub discs: usize,
+    /// The coarse window that gave the window's edge, if any (shared with the next replans,
+    /// which may reuse it: see [`COARSE_REUSE`]).
+    coarse: Option<Arc<Coarse>>,
+    /// Conjugate gradient iterations of the solve (the coarse window's too, when it was
+    /// solved for this one).
+    pub iterations: usize,
+    /// Wall-clock time of the solve.
+    pub solve_time: Duration,
+}
+
+/// A Dirichlet problem on a window: which cells the agent's centre may be in, which hold
+/// fixed values, and the values (fixed ones, and the starting guess of the others).
+struct Problem {
+    grid: Grid,
+    /// Free: the field of the walls reaches it and no disc covers it.
+    free: Vec<bool>,
+    /// Dirichlet cells: the ring, the target disc, and every cell that is not free (`W = 0`).
+    known: Vec<bool>,
+    /// The Dirichlet values, and the starting guess elsewhere.
+    values: ScaledW,
+}
+
+/// How many fine cells a cell of the coarse window spans along x and y.
+pub const COARSE: usize = 4;
+
+/// How many replans after the one that solved it a coarse window serves (with the discs where
+/// they were then), while the agent stays within a quarter of its reach of where it was solved:
+/// the agents it shows are far, and move little between replans, so it is re-solved every fifth
+/// replan (twice a second at 10 Hz).
+pub const COARSE_REUSE: u32 = 4;
+
+/// The relative residual a window is solved to, unless the field's own tolerance is looser:
+/// the window's difference from a full re-solve (degrees of guidance near the others) is far
+/// above what a tighter solve would change, and 1e-9 takes about a third fewer iterations than
+/// the default 1e-12. Cells below what it resolves go to the nested levels as in a full solve.
+pub const WINDOW_TOLERANCE: f64 = 1e-9;
+
+/// A coarse window, and how it was made.
+#[derive(Debug)]
+struct Coarse {
+    sampler: Arc<Sampler>,
+    /// Where the agent was when it was solved, m.
+    centre: [f64; 2],
+    /// Replans it has served since.
+    reused: u32,
+}
+
+impl Window {
+    /// Re-solves `field` (the agent's field of the walls, on `grid` with `reachable` cells and
+    /// its `w`) in the square of half-side `half` metres around `position`, with the discs
+    /// `others` as obstacles, to a relative residual of `tolerance`.
+    ///
+    /// The window's outermost ring of cells holds the Dirichlet data, and so do the target
+    /// disc's cells (`W = 1`) and the cells the field does not reach (`W = 0`); the cells of the
+    /// other agents' discs (grown by the agent's radius) are `W = 0`. Cells cut off by the
+    /// discs from the ring and the target are `W = 0` too. An agent cut off itself is an error
+    /// ([`FieldError::Unreachable`]), as in a full re-solve; so is an agent whose way on the
+    /// others block in the window (see `leads_on`): whether there is a detour beyond the
+    /// window only a full re-solve can say.
+    ///
+    /// The ring's values come from a coarse window first, when `reach` exceeds `half`: the
+    /// square of half-side `reach` at [`COARSE`] times the cell, solved the same way with the
+    /// discs in it and the field of the walls on its own ring. So the agents up to `reach` away
+    /// bend the guidance (a crowd ahead is gone around early), at the cost of a second window
+    /// of about as many cells, whatever the size of the world.
+    ///
+    /// `previous` is the window of the last replan on the same field of the walls, whose
+    /// coarse window may serve again ([`COARSE_REUSE`]).
+    pub(super) fn solve(
+        (grid, reachable, w): (&Grid, &[bool], &ScaledW),
+        agent: &Agent,
+        position: [f64; 2],
+        (half, reach): (f64, f64),
+        (others, previous): (&[Disc], Option<&Window>),
+        tolerance: f64,
+    ) -> Result<Self, FieldError> {
+        let started = Instant::now();
+        let unreachable = || FieldError::Unreachable {
+            agent: agent.name.clone(),
+            radius: agent.radius,
+        };
+        let discs: Vec<Disc> = obstacle_discs(agent, position, grid.cell, others)
+            .filter(|d| {
+                let r = d.radius + agent.radius + half.max(reach);
+                (d.center[0] - position[0]).abs() < r && (d.center[1] - position[1]).abs() < r
+            })
+            .copied()
+            .collect();
+        let reusable = previous.and_then(|p| p.coarse.as_ref()).filter(|c| {
+            c.reused < COARSE_REUSE
+                && (c.centre[0] - position[0]).hypot(c.centre[1] - position[1]) < 0.25 * reach
+        });
+        let mut coarse_iterations = 0;
+        let coarse = match reusable {
+            Some(c) => Some(Arc::new(Coarse {
+                sampler: Arc::clone(&c.sampler),
+                centre: c.centre,
+                reused: c.reused + 1,
+            })),
+            None if reach > half => {
+                let problem = coarse_problem((grid, reachable, w), agent, position, reach, &discs);
+                solve_problem(problem, agent, position, tolerance).ok().map(
+                    |(sampler, iterations)| {
+                        coarse_iterations = iterations;
+                        Arc::new(Coarse {
+                            sampler: Arc::new(sampler),
+                            centre: position,
+                            reused: 0,
+                        })
+                    },
+                )
+            }
+            None => None,
+        };
+        // The fine window: a part of the agent's grid.
+        let (ir, jr) = grid.cells_in(
+            [position[0] - half, position[1] - half],
+            [position[0] + half, position[1] + half],
+        );
+        let local = Grid {
+            nx: ir.len(),
+            ny: jr.len(),
+            cell: grid.cell,
+            origin: grid.center(ir.start, jr.start).map(|c| c - 0.5 * grid.cell),
+        };
+        if local.nx < 3 || local.ny < 3 {
+            return Err(unreachable());
+        }
+        let global = |k: usize| grid.index(ir.start + k % local.nx, jr.start + k / local.nx);
+        let n = local.len();
+        let under_disc = stamp(&local, &discs, agent.radius);
+        let mut problem = Problem {
+            grid: local,
+            free: vec![false; n],
+            known: vec![true; n],
+            values: ScaledW {
+                mantissa: vec![0.0; n],
+                exponent: vec![0; n],
+            },
+        };
+        for k in 0..n {
+            let (i, j) = (k % local.nx, k / local.nx);
+            let g = global(k);
+            let centre = local.center(i, j);
+            problem.free[k] = reachable[g] && !under_disc[k];
+            let ring = i == 0 || j == 0 || i + 1 == local.nx || j + 1 == local.ny;
+            problem.known[k] = !problem.free[k] || ring;
+            (problem.values.mantissa[k], problem.values.exponent[k]) =
+                (w.mantissa[g], w.exponent[g]);
+            // The ring from the coarse window where it has a value there.
+            if ring
+                && problem.free[k]
+                && let Some(coarse) = &coarse
+                && let Some((m, e)) = coarse.sampler.w_scaled(centre)
+                && m > 0.0
+            {
+                (problem.values.mantissa[k], problem.values.exponent[k]) = (m, e);
+            }
+        }
+        for g in disc_cells(
+            grid,
+            reachable,
+            agent.target,
+            agent.target_disc() + 0.5 * grid.cell,
+        ) {
+            let (gi, gj) = (g % grid.nx, g / grid.nx);
+            if ir.contains(&gi) && jr.contains(&gj) {
+                problem.known[local.index(gi - ir.start, gj - jr.start)] = true;
+            }
+        }
+        if !leads_on(&problem, (grid, reachable, w), (&ir, &jr), position) {
+            return Err(unreachable());
+        }
+        let (sampler, iterations) = solve_problem(problem, agent, position, tolerance)?;
+        let interior = [[1.0, local.nx as f64 - 2.0], [1.0, local.ny as f64 - 2.0]];
+        Ok(Self {
+            sampler,
+            interior,
+            discs: discs.len(),
+            coarse,
+            iterations: iterations + coarse_iterations,
+            solve_time: started.elapsed(),
+        })
+    }
+
+    /// The window's field.
+    pub fn sampler(&self) -> &Sampler {
+        &self.sampler
+    }
+
+    /// The window's cells.
+    pub fn grid(&self) -> &Grid {
+        self.sampler.grid()
+    }
+
+    /// Whether samples at `p` are read from the window: its interior, where the interpolation
+    /// stencil lies at least one cell inside the window's edge.
+    pub fn covers(&self, p: [f64; 2]) -> bool {
+        let g = self.grid();
+        let fx = (p[0] - g.origin[0]) / g.cell - 0.5;
+        let fy = (p[1] - g.origin[1]) / g.cell - 0.5;
+        let [x, y] = self.interior;
+        fx >= x[0] && fx < x[1] && fy >= y[0] && fy < y[1]
+    }
+}
+
+/// The coarse window: [`COARSE`] times the cell, half-side `reach` around `position`, clipped
+/// to the agent's grid. A coarse cell is free when the fine cell at its centre is reachable and
+/// no disc covers its centre; its ring holds the field of the walls, the cells of the target
+/// disc hold `W = 1`.
+fn coarse_problem(
+    (grid, reachable, w): (&Grid, &[bool], &ScaledW),
+    agent: &Agent,
+    position: [f64; 2],
+    reach: f64,
+    discs: &[Disc],
+) -> Problem {
+    let cell = grid.cell * COARSE as f64;
+    let lo = [grid.origin[0], grid.origin[1]];
+    let hi = [
+        grid.origin[0] + grid.nx as f64 * grid.cell,
+        grid.origin[1] + grid.ny as f64 * grid.cell,
+    ];
+    let from = [
+        (position[0] - reach).max(lo[0]),
+        (position[1] - reach).max(lo[1]),
+    ];
+    let to = [
+        (position[0] + reach).min(hi[0]),
+        (position[1] + reach).min(hi[1]),
+    ];
+    let coarse = Grid {
+        nx: (((to[0] - from[0]) / cell).ceil() as usize).max(1),
+        ny: (((to[1] - from[1]) / cell).ceil() as usize).max(1),
+        cell,
+        origin: from,
+    };
+    let n = coarse.len();
+    let under_disc = stamp(&coarse, discs, agent.radius);
+    let target_radius = agent.target_disc() + 0.5 * cell;
+    let target_cell = coarse.cell_of(agent.target);
+    let mut problem = Problem {
+        grid: coarse,
+        free: vec![false; n],
+        known: vec![true; n],
+        values: ScaledW {
+            mantissa: vec![0.0; n],
+            exponent: vec![0; n],
+        },
+    };
+    for k in 0..n {
+        let (i, j) = (k % coarse.nx, k / coarse.nx);
+        let centre = coarse.center(i, j);
+        let Some((fi, fj)) = grid.cell_of(centre) else {
+            continue;
+        };
+        let g = grid.index(fi, fj);
+        problem.free[k] = reachable[g] && !under_disc[k];
+        let ring = i == 0 || j == 0 || i + 1 == coarse.nx || j + 1 == coarse.ny;
+        let target = target_cell == Some((i, j))
+            || (centre[0] - agent.target[0]).hypot(centre[1] - agent.target[1]) <= target_radius;
+        problem.known[k] = !problem.free[k] || ring || target;
+        if target && problem.free[k] {
+            (problem.values.mantissa[k], problem.values.exponent[k]) = (1.0, 0);
+        } else {
+            (problem.values.mantissa[k], problem.values.exponent[k]) =
+                (w.mantissa[g], w.exponent[g]);
+        }
+    }
+    problem
+}
+
+/// Solves a window's Dirichlet problem: the free cells connected to the Dirichlet data (the
+/// free known cells with `W > 0`) are solved, at the scale of the largest Dirichlet value, then
+/// the nested levels below what the solve resolves, as in a full solve. The Dirichlet cells
+/// keep their own values and exponents (they may be deeper than f64 reaches at that scale).
+/// Returns the sampler and the iterations; an error when the agent at `position` is cut off.
+fn solve_problem(
+    problem: Problem,
+    agent: &Agent,
+    position: [f64; 2],
+    tolerance: f64,
+) -> Result<(Sampler, usize), FieldError> {
+    let Problem {
+        grid: local,
+        free,
+        known,
+        values: given,
+    } = problem;
+    let unreachable = || FieldError::Unreachable {
+        agent: agent.name.clone(),
+        radius: agent.radius,
+    };
+    let n = local.len();
+    let mut connected = vec![false; n];
+    let mut stack: Vec<usize> = (0..n)
+        .filter(|&k| free[k] && known[k] && given.mantissa[k] > 0.0)
+        .collect();
+    for &k in &stack {
+        connected[k] = true;
+    }
+    while let Some(k) = stack.pop() {
+        for m in local.neighbours_of(k) {
+            if free[m] && !connected[m] {
+                connected[m] = true;
+                stack.push(m);
+            }
+        }
+    }
+    let at = local.cell_of(position).ok_or_else(unreachable)?;
+    let near = |c: usize, len: usize| c.saturating_sub(1)..=(c + 1).min(len - 1);
+    if !near(at.0, local.nx).any(|i| near(at.1, local.ny).any(|j| connected[local.index(i, j)])) {
+        return Err(unreachable());
+    }
+    let unknown: Vec<bool> = (0..n).map(|k| connected[k] && !known[k]).collect();
+    // Everything at the scale of the largest Dirichlet value, so the solve works on values of
+    // order 1 wherever the window is (deep in a maze too).
+    let top = (0..n)
+        .filter(|&k| connected[k] && known[k] && given.mantissa[k] > 0.0)
+        .map(|k| given.exponent[k] + exponent_of(given.mantissa[k]))
+        .max()
+        .ok_or_else(unreachable)?;
+    let mut values: Vec<f64> = (0..n)
+        .map(|k| {
+            if connected[k] {
+                ldexp(given.mantissa[k], given.exponent[k] - top)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let stats = multigrid::solve(&local, &unknown, &mut values, tolerance, MAX_ITERATIONS);
+    if stats.relative_residual.is_nan() || stats.relative_residual > tolerance {
+        return Err(FieldError::Solver {
+            agent: agent.name.clone(),
+            iterations: stats.iterations,
+            relative_residual: stats.relative_residual,
+        });
+    }
+    let pending = deep_cells(&local, &unknown, &values, DEPTH_STEP);
+    let mut scaled = ScaledW {
+        mantissa: values,
+        exponent: vec![top; n],
+    };
+    for k in 0..n {
+        if connected[k] && known[k] {
+            scaled.mantissa[k] = given.mantissa[k];
+            scaled.exponent[k] = given.exponent[k];
+        } else if !connected[k] {
+            scaled.exponent[k] = 0;
+        }
+    }
+    let nested = solve_levels(&local, pending, &mut scaled, tolerance);
+    Ok((
+        Sampler::new(local, scaled, connected),
+        stats.iterations + nested.iterations,
+    ))
+}
+
+/// The cells of `grid` whose centres lie inside one of the `discs` grown by `radius`: each
+/// disc marks only the cells of its bounding box.
+fn stamp(grid: &Grid, discs: &[Disc], radius: f64) -> Vec<bool> {
+    let mut under = vec![false; grid.len()];
+    for d in discs {
+        let r = d.radius + radius;
+        let (ir, jr) = grid.cells_in(
+            [d.center[0] - r, d.center[1] - r],
+            [d.center[0] + r, d.center[1] + r],
+        );
+        for j in jr {
+            for i in ir.clone() {
+                let [x, y] = grid.center(i, j);
+                if (x - d.center[0]).hypot(y - d.center[1]) < r {
+                    under[grid.index(i, j)] = true;
+                }
+            }
+        }
+    }
+    under
+}
+
+/// Whether the part of the window the agent is in leads on: it holds a cell of the target disc,
+/// or a cell of the ring where the field of the walls is at least what it is at the agent.
+///
+/// Without the others, the field of the walls rises along the agent's streamline to the target,
+/// which leaves the window through a ring cell where `W` is higher than at the agent (or ends
+/// at the target inside it). When the others cut the agent off from every such cell, the only
+/// ways out of the window go back down the field: a window solved with that edge would turn the
+/// agent round whether or not a detour exists (in a corridor one robot wide it does not), so the
+/// caller decides with a full re-solve instead.
+fn leads_on(
+    problem: &Problem,
+    (grid, reachable, w): (&Grid, &[bool], &ScaledW),
+    (ir, jr): (&std::ops::Range<usize>, &std::ops::Range<usize>),
+    position: [f64; 2],
+) -> bool {
+    let local = &problem.grid;
+    let global = |k: usize| grid.index(ir.start + k % local.nx, jr.start + k / local.nx);
+    let log2 = |g: usize| w.mantissa[g].log2() + f64::from(w.exponent[g]);
+    // The field of the walls at the agent: the best reachable cell around it.
+    let Some((ci, cj)) = grid.cell_of(position) else {
+        return false;
+    };
+    let near = |c: usize, len: usize| c.saturating_sub(1)..=(c + 1).min(len - 1);
+    let here = near(ci, grid.nx)
+        .flat_map(|i| near(cj, grid.ny).map(move |j| grid.index(i, j)))
+        .filter(|&g| reachable[g] && w.mantissa[g] > 0.0)
+        .map(log2)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let Some((li, lj)) = local.cell_of(position) else {
+        return false;
+    };
+    let mut seen = vec![false; local.len()];
+    let mut stack: Vec<usize> = near(li, local.nx)
+        .flat_map(|i| near(lj, local.ny).map(move |j| local.index(i, j)))
+        .filter(|&k| problem.free[k])
+        .collect();
+    for &k in &stack {
+        seen[k] = true;
+    }
+    while let Some(k) = stack.pop() {
+        if problem.known[k] {
+            let g = global(k);
+            // A target cell (W = 1), or a ring cell at least as high as the agent.
+            if w.mantissa[g] > 0.0 && log2(g) >= here {
+                return true;
+            }
+            continue;
+        }
+        for m in local.neighbours_of(k) {
+            if problem.free[m] && !seen[m] {
+                seen[m] = true;
+                stack.push(m);
+            }
+        }
+    }
+    false
+}
