@@ -20,8 +20,12 @@ fn antipodal(n: usize, room: Option<f64>) -> String {
     let size = room.unwrap_or(2.0 * radius + 2.4);
     let centre = 0.5 * size;
     // Twice the time of the longest path (a diameter at 2 m/s), and 20 s more to get past the
-    // others at the centre.
-    let duration = (2.0 * radius + 20.0).ceil();
+    // others at the centre; in a larger room, at least its width at 2 m/s and 34 s more (the
+    // robots go round the crowd there rather than through it: 50 s for all 32 in a 48 m room).
+    let duration = match room {
+        None => (2.0 * radius + 20.0).ceil(),
+        Some(room) => (2.0 * radius + 20.0).max(0.5 * room + 34.0).ceil(),
+    };
     let name = match room {
         None => format!("circle-{n}"),
         Some(room) => format!("circle-{n}-room-{room}"),

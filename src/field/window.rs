@@ -80,6 +80,22 @@ struct Problem {
     values: ScaledW,
 }
 
+impl Problem {
+    /// Every cell of `grid` blocked and known at `W = 0`, to be filled in.
+    fn blank(grid: Grid) -> Self {
+        let n = grid.len();
+        Self {
+            grid,
+            free: vec![false; n],
+            known: vec![true; n],
+            values: ScaledW {
+                mantissa: vec![0.0; n],
+                exponent: vec![0; n],
+            },
+        }
+    }
+}
+
 /// How many fine cells a cell of the coarse window spans along x and y.
 pub const COARSE: usize = 4;
 
@@ -189,15 +205,7 @@ impl Window {
         let global = |k: usize| grid.index(ir.start + k % local.nx, jr.start + k / local.nx);
         let n = local.len();
         let under_disc = stamp(&local, &discs, agent.radius);
-        let mut problem = Problem {
-            grid: local,
-            free: vec![false; n],
-            known: vec![true; n],
-            values: ScaledW {
-                mantissa: vec![0.0; n],
-                exponent: vec![0; n],
-            },
-        };
+        let mut problem = Problem::blank(local);
         for k in 0..n {
             let (i, j) = (k % local.nx, k / local.nx);
             let g = global(k);
@@ -299,15 +307,7 @@ fn coarse_problem(
     let under_disc = stamp(&coarse, discs, agent.radius);
     let target_radius = agent.target_disc() + 0.5 * cell;
     let target_cell = coarse.cell_of(agent.target);
-    let mut problem = Problem {
-        grid: coarse,
-        free: vec![false; n],
-        known: vec![true; n],
-        values: ScaledW {
-            mantissa: vec![0.0; n],
-            exponent: vec![0; n],
-        },
-    };
+    let mut problem = Problem::blank(coarse);
     for k in 0..n {
         let (i, j) = (k % coarse.nx, k / coarse.nx);
         let centre = coarse.center(i, j);
