@@ -35,23 +35,37 @@ fn fixture(name: &str) -> std::path::PathBuf {
 
 /// Every entity path and timeline in a recording, read back with Rerun's own decoder.
 fn decode(path: &Path) -> (BTreeSet<String>, BTreeSet<String>) {
+    let rows = rows_on_sim_time(path);
+    let entities = rows.keys().cloned().collect();
     let file = BufReader::new(std::fs::File::open(path).unwrap());
     let messages = re_log_encoding::DecoderApp::decode_eager(file).unwrap();
-    let (mut entities, mut timelines) = (BTreeSet::new(), BTreeSet::new());
+    let mut timelines = BTreeSet::new();
     for msg in messages {
         if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
             let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
-            entities.insert(
-                chunk
-                    .entity_path()
-                    .to_string()
-                    .trim_start_matches('/')
-                    .to_string(),
-            );
             timelines.extend(chunk.timelines().keys().map(|t| t.as_str().to_string()));
         }
     }
     (entities, timelines)
+}
+
+/// Per entity of a recording, how many rows it has on the `sim_time` timeline (0 for static
+/// entities).
+fn rows_on_sim_time(path: &Path) -> std::collections::BTreeMap<String, usize> {
+    let file = BufReader::new(std::fs::File::open(path).unwrap());
+    let messages = re_log_encoding::DecoderApp::decode_eager(file).unwrap();
+    let mut rows = std::collections::BTreeMap::new();
+    for msg in messages {
+        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
+            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
+            let entity = chunk.entity_path().to_string();
+            let timed = chunk.timelines().keys().any(|t| t.as_str() == "sim_time");
+            *rows
+                .entry(entity.trim_start_matches('/').to_string())
+                .or_insert(0) += if timed { chunk.num_rows() } else { 0 };
+        }
+    }
+    rows
 }
 
 #[test]
@@ -84,7 +98,7 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
         "agents/robot/kinematic_path",
         "agents/robot/target",
         "agents/robot/body",
-        "agents/robot/trail",
+        "agents/robot/trail/0",
         "agents/robot/velocity",
         "agents/robot/force",
         "agents/robot/contacts",
@@ -99,6 +113,19 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
         assert!(entities.contains(e), "no `{e}` in {entities:?}");
     }
     assert!(timelines.contains("sim_time"), "{timelines:?}");
+    // Every step of the 8 s is there, though sent in columns of 500 steps (the last 300 when
+    // the run ended): the body, its arrows and contacts, and every series.
+    let rows = rows_on_sim_time(&rrd);
+    for e in [
+        "agents/robot/body",
+        "agents/robot/velocity",
+        "agents/robot/force",
+        "agents/robot/contacts",
+        "plots/robot/distance",
+        "plots/robot/potential",
+    ] {
+        assert_eq!(rows[e], 800, "{e}");
+    }
     // Only the finished files are left: no `.partial`.
     let mut names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()

@@ -5,22 +5,20 @@
 use rerun::RecordingStream;
 
 use super::colormap;
+use super::columns::AgentColumns;
 use super::names::{AGENT_SERIES, AgentPaths, plot};
 use super::palette::{self, size};
 use super::world::f32x2;
 use crate::sim::{AgentRun, AgentState, Simulation};
 
-/// Steps between two updates of the trail (which is re-logged whole).
+/// Steps between two updates of the trail.
 const TRAIL_EVERY: usize = 25;
-/// Most points in a logged trail: a longer one is thinned evenly (its last point kept), so a
-/// long run's recording grows linearly, not quadratically.
-const TRAIL_POINTS: usize = 2000;
+/// Steps per piece of the trail: the trail is logged in pieces, `…/trail/0`, `…/trail/1`, …,
+/// each re-logged as it grows (every [`TRAIL_EVERY`] steps) and then left alone, so the trail
+/// up to any instant shows in the viewer and the recording grows linearly with the run.
+const TRAIL_PIECE: usize = 1000;
 /// Arrows shown per side of the box in the guidance arrow field.
 const GUIDANCE_ARROWS: usize = 24;
-/// Length of a velocity arrow per m/s, m.
-const VELOCITY_SCALE: f32 = 0.5;
-/// Length of a force arrow per N, m.
-const FORCE_SCALE: f32 = 0.5;
 
 /// Logs each agent's field, guidance, kinematic path, start, target and series' labels
 /// (static).
@@ -94,18 +92,22 @@ pub fn log_setup(
     Ok(())
 }
 
-/// The agents' trails so far, re-logged whole every [`TRAIL_EVERY`] steps.
+/// The agents' trails, and the per-step values waiting to be sent as columns.
 #[derive(Default)]
 pub struct Trails {
+    /// Per agent, the points of the trail's current piece (its first point is the last of the
+    /// piece before).
     points: Vec<Vec<[f32; 2]>>,
+    /// Per agent, its columns (made at the first step).
+    columns: Vec<AgentColumns>,
     steps: usize,
     /// Per agent, the lidar field last logged (`LidarRun::fields`).
     fields_logged: Vec<usize>,
 }
 
 impl Trails {
-    /// Logs each agent's state after a step; `last` is the run's last step (the trail is then
-    /// logged whatever the count).
+    /// Logs each agent's state after a step; `last` is the run's last step (the trail and the
+    /// columns are then logged whatever the count).
     pub fn log_step(
         &mut self,
         rec: &RecordingStream,
@@ -117,12 +119,17 @@ impl Trails {
         self.steps += 1;
         self.points.resize(agents.len(), Vec::new());
         self.fields_logged.resize(agents.len(), 0);
+        if self.columns.is_empty() {
+            self.columns = (agents.iter())
+                .map(|run| AgentColumns::new(rec, run))
+                .collect::<Result<_, _>>()?;
+        }
         for (index, ((run, state), trail)) in
             agents.iter().zip(states).zip(&mut self.points).enumerate()
         {
             let paths = AgentPaths::of(&run.agent.name);
             let p = f32x2(state.position.into());
-            log_body(rec, &paths, run, state, p)?;
+            log_events(rec, &paths, state)?;
             if let Some(lidar) = &run.lidar {
                 let due = lidar.lidar.scans % LIDAR_IMAGE_EVERY == 1;
                 let new = self.fields_logged[index] != lidar.fields;
@@ -131,28 +138,33 @@ impl Trails {
                 }
                 log_lidar(rec, &paths, sim, run, state, due && new)?;
             }
-            for series in AGENT_SERIES.iter().filter(|s| (s.shown)(&run.agent)) {
-                rec.log(
-                    plot(&run.agent.name, series.key),
-                    &rerun::Scalars::single((series.value)(&run.agent, state)),
-                )?;
+            let columns = &mut self.columns[index];
+            columns.push(sim.time(), run, state);
+            if columns.full() || last {
+                columns.send(rec)?;
             }
             trail.push(p);
-            if self.steps % TRAIL_EVERY == 1 || last {
-                let stride = trail.len().div_ceil(TRAIL_POINTS);
-                let mut points: Vec<[f32; 2]> = trail.iter().step_by(stride).copied().collect();
-                if (trail.len() - 1) % stride != 0 {
-                    points.push(p);
-                }
+            let piece = (self.steps - 1) / TRAIL_PIECE;
+            let piece_ends = self.steps.is_multiple_of(TRAIL_PIECE);
+            if self.steps % TRAIL_EVERY == 1 || piece_ends || last {
                 rec.log(
-                    paths.trail,
-                    &rerun::LineStrips2D::new([points])
+                    format!("{}/{piece}", paths.trail),
+                    &rerun::LineStrips2D::new([trail.iter().copied()])
                         .with_colors([palette::rerun(palette::BODY)])
                         .with_radii([size::points(size::PATH)]),
                 )?;
             }
+            if piece_ends {
+                trail.clear();
+                trail.push(p);
+            }
         }
         Ok(())
+    }
+
+    /// Sends the per-step values still waiting (the run was interrupted before its last step).
+    pub fn flush(&mut self, rec: &RecordingStream) -> Result<(), rerun::RecordingStreamError> {
+        self.columns.iter_mut().try_for_each(|c| c.send(rec))
     }
 }
 
@@ -249,52 +261,12 @@ fn arrows(sim: &Simulation, run: &AgentRun) -> rerun::Arrows2D {
         )])
 }
 
-/// The body at `p`, its arrows, contacts, events and sensed walls.
-fn log_body(
+/// The agent's events of the step (WARN) and notes (INFO), and the walls its sensor saw.
+fn log_events(
     rec: &RecordingStream,
     paths: &AgentPaths,
-    run: &AgentRun,
     state: &AgentState,
-    p: [f32; 2],
 ) -> Result<(), rerun::RecordingStreamError> {
-    let colour = if state.contact_points.is_empty() {
-        palette::BODY
-    } else {
-        palette::TOUCHING
-    };
-    rec.log(
-        paths.body.as_str(),
-        &rerun::Points2D::new([p])
-            .with_radii([run.agent.radius as f32])
-            .with_colors([palette::rerun(colour)]),
-    )?;
-    for (path, vector, scale, colour) in [
-        (
-            &paths.velocity,
-            state.velocity,
-            VELOCITY_SCALE,
-            palette::VELOCITY,
-        ),
-        (&paths.force, state.force, FORCE_SCALE, palette::FORCE),
-    ] {
-        rec.log(
-            path.as_str(),
-            &rerun::Arrows2D::from_vectors([[vector.x as f32 * scale, vector.y as f32 * scale]])
-                .with_origins([p])
-                .with_colors([palette::rerun(colour)]),
-        )?;
-    }
-    let contacts: Vec<[f32; 2]> = state
-        .contact_points
-        .iter()
-        .map(|c| f32x2((*c).into()))
-        .collect();
-    rec.log(
-        paths.contacts.as_str(),
-        &rerun::Points2D::new(contacts)
-            .with_radii([size::points(size::CONTACT)])
-            .with_colors([palette::rerun(palette::CONTACT)]),
-    )?;
     for (messages, level) in [
         (&state.events, rerun::TextLogLevel::WARN),
         (&state.notes, rerun::TextLogLevel::INFO),

@@ -7,7 +7,9 @@
 //!   grey, free cells the target cannot be reached from are black.
 //! - `agents/NAME/field/guidance`: a sparse arrow field of the unit guidance `-∇V/|∇V|` (static).
 //! - `agents/NAME/kinematic_path`, `agents/NAME/target` (static).
-//! - `agents/NAME/body`, `…/trail`, `…/velocity`, `…/force`, `…/contacts`: per step.
+//! - `agents/NAME/body`, `…/velocity`, `…/force`, `…/contacts`: per step, sent as columns
+//!   every 500 steps (`columns.rs`); `…/trail/K`: the trail in pieces of 1000 steps, each
+//!   updated every 25 steps while it grows.
 //! - `agents/NAME/events`: numerical faults and contacts as they start (text log, level WARN),
 //!   bias updates and sensing problems (level INFO).
 //! - `agents/NAME/sensed_walls`: with a noisy sensor, the outline of the configuration-space
@@ -36,6 +38,7 @@
 mod agents;
 mod blueprint;
 mod colormap;
+mod columns;
 mod names;
 mod palette;
 mod pendulums;
@@ -155,14 +158,19 @@ impl Recorder {
             stream,
             partial,
             path,
+            mut trails,
             ..
         } = self;
-        if let Err(e) = stream.flush_blocking() {
+        let flushed = trails
+            .flush(&stream)
+            .map_err(|e| e.to_string())
+            .and_then(|()| stream.flush_blocking().map_err(|e| e.to_string()));
+        if let Err(message) = flushed {
             drop(stream);
             let _ = std::fs::remove_file(&partial);
             return Err(RecordError::Flush {
                 path: partial,
-                message: e.to_string(),
+                message,
             });
         }
         // The footer is written when the last handle to the stream is dropped.
