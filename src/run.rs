@@ -10,7 +10,7 @@ use serde::Serialize;
 use crate::field::{FieldError, FreeSpace};
 use crate::metrics::{self, Summary};
 use crate::output::{self, OutputError};
-use crate::record::{RecordError, Recorder};
+use crate::record::{RecordError, Recorder, Viewer};
 use crate::sim::Simulation;
 use crate::sim::pendulum::PendulumSummary;
 use crate::world::World;
@@ -18,8 +18,10 @@ use crate::world::World;
 /// What a run writes.
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
-    /// Where to write the recording; `None` records nothing.
+    /// Where to write the recording; `None` writes no file.
     pub recording: Option<PathBuf>,
+    /// A Rerun viewer to stream the run into as it goes, if any (besides the file, if any).
+    pub viewer: Option<Viewer>,
     /// Where to write the JSON summary; `None` writes none.
     pub json: Option<PathBuf>,
     /// Show a progress bar on standard error.
@@ -130,16 +132,16 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
             })
         })
         .collect();
-    let mut recorder = match &options.recording {
-        Some(path) => {
-            let mut r = Recorder::create(path, world)?;
+    let mut recorder = match (&options.recording, &options.viewer) {
+        (None, None) => None,
+        (path, viewer) => {
+            let mut r = Recorder::create_to(path.as_deref(), viewer.as_ref(), world)?;
             if let Err(e) = r.log_setup(&sim) {
                 r.abandon();
                 return Err(e.into());
             }
             Some(r)
         }
-        None => None,
     };
     let bar = options.progress.then(|| {
         let bar = indicatif::ProgressBar::new(world.steps() as u64);
@@ -199,7 +201,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
             return Err(e.into());
         }
     }
-    let recording = recorder.map(Recorder::finish).transpose()?;
+    let recording = recorder.map(Recorder::finish).transpose()?.flatten();
     let report = Report {
         world: world.name().to_string(),
         agents: sim.summaries(),

@@ -471,3 +471,102 @@ fn outputs_that_cannot_be_written_are_bad_input_found_before_the_run() {
     left.sort();
     assert_eq!(left, ["sweep.csv"]);
 }
+
+/// `--connect URL` streams a run, as it goes, to a running viewer: here a `rerun` process
+/// listening on a free port and saving what it receives (`rerun --port P --save FILE`), whose
+/// file then holds the run. With `-o` the file is written as well. Skipped, saying why, only
+/// when no `rerun` executable is installed (`.ci/run` installs the matching one).
+#[test]
+fn connect_streams_the_run_to_a_running_viewer() {
+    if Command::new("rerun").arg("--version").output().is_err() {
+        eprintln!("skipped: no `rerun` executable on the PATH (pip install rerun-sdk==0.36.3)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let received = dir.path().join("received.rrd");
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let mut viewer = Command::new("rerun")
+        .args(["--port", &port.to_string(), "--save"])
+        .arg(&received)
+        .env("RUST_LOG", "warn")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        assert!(
+            started.elapsed().as_secs() < 30,
+            "the viewer never listened"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let url = format!("rerun+http://127.0.0.1:{port}/proxy");
+    let out = run_room(
+        dir.path(),
+        &["--connect", &url, "-o", "also.rrd", "--set", "duration=8"],
+    );
+    common::assert_success(&out);
+    // The viewer writes what it receives as it comes: wait for the last step's columns.
+    let has_run = |path: &Path| {
+        path.exists()
+            && rows_on_sim_time(path)
+                .get("agents/robot/body")
+                .is_some_and(|rows| *rows == 800)
+    };
+    let started = std::time::Instant::now();
+    while !has_run(&received) && started.elapsed().as_secs() < 30 {
+        std::thread::sleep(std::time::Duration::from_millis(200));
+    }
+    let _ = viewer.kill();
+    let _ = viewer.wait();
+    assert!(
+        has_run(&received),
+        "the viewer did not receive all 800 steps"
+    );
+    let (entities, _) = decode(&received);
+    for e in [
+        "world/walls",
+        "agents/robot/field/potential",
+        "plots/robot/distance",
+    ] {
+        assert!(entities.contains(e), "no `{e}` in {entities:?}");
+    }
+    assert!(has_run(&dir.path().join("also.rrd")));
+}
+
+/// `--spawn` without a viewer installed fails before anything is simulated, saying how to
+/// install the matching one; `--connect` to something that is not a viewer's URL too.
+#[test]
+fn spawn_without_a_viewer_and_a_bad_url_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("room-two-dividers.toml");
+    let out = Command::new(nadf_bin())
+        .current_dir(dir.path())
+        .args(["run", world.to_str().unwrap(), "--spawn"])
+        .env("PATH", dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("cannot start a Rerun viewer")
+            && stderr.contains("pip install rerun-sdk==0.36.3"),
+        "{stderr}"
+    );
+    let out = run_room(
+        dir.path(),
+        &["--connect", "http://example.com/not-a-viewer"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("cannot stream to `http://example.com/not-a-viewer`"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use super::{Console, Failure, bad_input, load};
+use crate::record::Viewer;
 use crate::run::RunOptions;
 use crate::world::Override;
 
@@ -18,6 +19,14 @@ pub struct RunArgs {
     /// Do not write a recording.
     #[arg(long, conflicts_with = "output")]
     pub no_record: bool,
+    /// Start a Rerun viewer (the `rerun` executable on the PATH) and stream the run into it as
+    /// it goes; no file is written unless -o is given too.
+    #[arg(long, conflicts_with = "connect")]
+    pub spawn: bool,
+    /// Stream the run as it goes to a running Rerun viewer at URL [default URL:
+    /// rerun+http://127.0.0.1:9876/proxy]; no file is written unless -o is given too.
+    #[arg(long, value_name = "URL", num_args = 0..=1, default_missing_value = crate::record::DEFAULT_VIEWER_URL)]
+    pub connect: Option<String>,
     /// Also write the summary as JSON to this file.
     #[arg(long, value_name = "SUMMARY.json")]
     pub json: Option<PathBuf>,
@@ -31,16 +40,32 @@ pub struct RunArgs {
 pub fn run(args: &RunArgs, console: &Console) -> Result<(), Failure> {
     let path = &args.world;
     let world = load(path, &args.overrides)?;
-    let recording = (!args.no_record).then(|| {
-        args.output.clone().unwrap_or_else(|| {
+    let viewer = match (&args.connect, args.spawn) {
+        (Some(url), _) => Some(Viewer::Connect(url.clone())),
+        (None, true) => Some(Viewer::Spawn),
+        (None, false) => None,
+    };
+    // Streaming to a viewer replaces the default file; -o saves one too.
+    let recording = match (&args.output, args.no_record, &viewer) {
+        (Some(out), _, _) => Some(out.clone()),
+        (None, true, _) | (None, false, Some(_)) => None,
+        (None, false, None) => {
             let stem = path
                 .file_stem()
                 .map_or_else(|| "world".into(), |s| s.to_owned());
-            PathBuf::from(stem).with_extension("rrd")
-        })
+            Some(PathBuf::from(stem).with_extension("rrd"))
+        }
+    };
+    let streamed = viewer.as_ref().map(|v| match v {
+        Viewer::Spawn => format!(
+            "streamed to a new viewer at {}",
+            crate::record::DEFAULT_VIEWER_URL
+        ),
+        Viewer::Connect(url) => format!("streamed to {url}"),
     });
     let options = RunOptions {
         recording,
+        viewer,
         json: args.json.clone(),
         progress: console.progress,
         interrupt: Some(console.interrupt.clone()),
@@ -55,6 +80,9 @@ pub fn run(args: &RunArgs, console: &Console) -> Result<(), Failure> {
             rrd.display()
         ),
         None => println!("wall time {wall:.2} s; no recording"),
+    }
+    if let Some(streamed) = streamed {
+        println!("{streamed}");
     }
     if let Some(t) = report.interrupted_at {
         return Err(Failure::Interrupted(format!(

@@ -51,6 +51,20 @@ use std::path::{Path, PathBuf};
 
 use rerun::{RecordingStream, RecordingStreamBuilder};
 
+/// A Rerun viewer to stream a run into as it goes, with Rerun's own conventions
+/// (`rerun::clap::RerunArgs`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Viewer {
+    /// Start a viewer (the `rerun` executable on the `PATH`) and stream into it.
+    Spawn,
+    /// Stream to a running viewer or gRPC server at this URL
+    /// (`rerun+http://HOST:PORT/proxy`; Rerun's default is [`DEFAULT_VIEWER_URL`]).
+    Connect(String),
+}
+
+/// Where `--connect` streams without a URL: Rerun's default.
+pub const DEFAULT_VIEWER_URL: &str = rerun::DEFAULT_CONNECT_URL;
+
 use crate::sim::{AgentState, Simulation};
 use crate::world::World;
 
@@ -77,6 +91,20 @@ pub enum RecordError {
         /// Rerun's error.
         message: String,
     },
+    /// No Rerun viewer could be started.
+    #[error(
+        "cannot start a Rerun viewer: {0}\ninstall the viewer that matches this build with `pip install rerun-sdk=={version}` (it provides the `rerun` executable), or stream to a running one with --connect",
+        version = rerun::build_info().version
+    )]
+    Spawn(String),
+    /// The viewer URL is not a Rerun gRPC proxy URL.
+    #[error("cannot stream to `{url}`: {message} (a viewer's URL looks like {DEFAULT_VIEWER_URL})")]
+    Url {
+        /// The URL given.
+        url: String,
+        /// Why it is not one.
+        message: String,
+    },
     /// The finished file could not be moved into place.
     #[error("cannot move the finished recording to {path}: {source}")]
     Rename {
@@ -87,11 +115,11 @@ pub enum RecordError {
     },
 }
 
-/// Streams a run into an `.rrd` file.
+/// Streams a run into an `.rrd` file, a Rerun viewer, or both.
 pub struct Recorder {
     stream: RecordingStream,
-    partial: PathBuf,
-    path: PathBuf,
+    /// The file being written and where it goes when it is complete, if any.
+    file: Option<(PathBuf, PathBuf)>,
     trails: agents::Trails,
     last_flush: std::time::Instant,
 }
@@ -99,19 +127,58 @@ pub struct Recorder {
 impl Recorder {
     /// Starts the recording of `world` that will end up at `path`.
     pub fn create(path: &Path, world: &World) -> Result<Self, RecordError> {
-        let partial = crate::output::partial_path(path);
-        let stream = RecordingStreamBuilder::new("nadf")
+        Self::create_to(Some(path), None, world)
+    }
+
+    /// Starts the recording of `world` into the file `path` (if any) and the `viewer` (if
+    /// any): a viewer is started, or the URL checked, before anything is simulated.
+    pub fn create_to(
+        path: Option<&Path>,
+        viewer: Option<&Viewer>,
+        world: &World,
+    ) -> Result<Self, RecordError> {
+        let file = path.map(|p| (crate::output::partial_path(p), p.to_path_buf()));
+        let builder = RecordingStreamBuilder::new("nadf")
             .recording_name(world.name())
-            .with_blueprint(blueprint::layout(world))
-            .save(&partial)
-            .map_err(|source| RecordError::Stream {
-                path: partial.clone(),
-                source,
-            })?;
+            .with_blueprint(blueprint::layout(world));
+        let stream_error = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| RecordError::Stream { path, source }
+        };
+        let stream = match (viewer, &file) {
+            (None, Some((partial, _))) => builder.save(partial).map_err(stream_error(partial))?,
+            (None, None) => RecordingStream::disabled(),
+            (Some(viewer), file) => {
+                let url = match viewer {
+                    Viewer::Spawn => {
+                        rerun::spawn(&rerun::SpawnOptions::default())
+                            .map_err(|e| RecordError::Spawn(e.to_string()))?;
+                        DEFAULT_VIEWER_URL.to_string()
+                    }
+                    Viewer::Connect(url) => url.clone(),
+                };
+                let uri = proxy_uri(&url)?;
+                // Buffered until the sinks are set: the blueprint goes to both.
+                let stream = builder.buffered().map_err(stream_error(Path::new(&url)))?;
+                let grpc = rerun::sink::GrpcSink::new(uri);
+                match file {
+                    Some((partial, _)) => {
+                        let sink = rerun::sink::FileSink::new(partial).map_err(|e| {
+                            RecordError::Flush {
+                                path: partial.clone(),
+                                message: e.to_string(),
+                            }
+                        })?;
+                        stream.set_sinks((grpc, sink));
+                    }
+                    None => stream.set_sinks((grpc,)),
+                }
+                stream
+            }
+        };
         Ok(Self {
             stream,
-            partial,
-            path: path.to_path_buf(),
+            file,
             trails: agents::Trails::default(),
             last_flush: std::time::Instant::now(),
         })
@@ -152,12 +219,12 @@ impl Recorder {
         )
     }
 
-    /// Closes the stream (which writes the file's footer) and moves the file into place.
-    pub fn finish(self) -> Result<PathBuf, RecordError> {
+    /// Closes the stream (which writes the file's footer, and sends everything to a viewer)
+    /// and moves the file into place; returns the file, if there is one.
+    pub fn finish(self) -> Result<Option<PathBuf>, RecordError> {
         let Self {
             stream,
-            partial,
-            path,
+            file,
             mut trails,
             ..
         } = self;
@@ -167,25 +234,45 @@ impl Recorder {
             .and_then(|()| stream.flush_blocking().map_err(|e| e.to_string()));
         if let Err(message) = flushed {
             drop(stream);
-            let _ = std::fs::remove_file(&partial);
+            if let Some((partial, _)) = &file {
+                let _ = std::fs::remove_file(partial);
+            }
             return Err(RecordError::Flush {
-                path: partial,
+                path: file.map_or_else(|| PathBuf::from("(the viewer)"), |(partial, _)| partial),
                 message,
             });
         }
         // The footer is written when the last handle to the stream is dropped.
         drop(stream);
+        let Some((partial, path)) = file else {
+            return Ok(None);
+        };
         std::fs::rename(&partial, &path).map_err(|source| RecordError::Rename {
             path: path.clone(),
             source,
         })?;
-        Ok(path)
+        Ok(Some(path))
     }
 
     /// Drops the stream and deletes the partial file (a failed run leaves nothing behind).
     pub fn abandon(self) {
-        let partial = self.partial.clone();
+        let file = self.file.clone();
         drop(self.stream);
-        let _ = std::fs::remove_file(partial);
+        if let Some((partial, _)) = file {
+            let _ = std::fs::remove_file(partial);
+        }
+    }
+}
+
+/// The gRPC proxy URI of a viewer's `url`.
+fn proxy_uri(url: &str) -> Result<rerun::external::re_uri::ProxyUri, RecordError> {
+    let bad = |message: String| RecordError::Url {
+        url: url.to_string(),
+        message,
+    };
+    match url.parse::<rerun::external::re_uri::RedapUri>() {
+        Ok(rerun::external::re_uri::RedapUri::Proxy(uri)) => Ok(uri),
+        Ok(_) => Err(bad("not a viewer's proxy endpoint".into())),
+        Err(e) => Err(bad(e.to_string())),
     }
 }
