@@ -98,8 +98,9 @@ pub struct Trails {
     /// Per agent, the points of the trail's current piece (its first point is the last of the
     /// piece before).
     points: Vec<Vec<[f32; 2]>>,
-    /// Per agent, its columns (made at the first step).
+    /// Per agent, its columns and its entity paths (made at the first step).
     columns: Vec<AgentColumns>,
+    paths: Vec<AgentPaths>,
     steps: usize,
     /// Per agent, the lidar field last logged (`LidarRun::fields`).
     fields_logged: Vec<usize>,
@@ -123,20 +124,23 @@ impl Trails {
             self.columns = (agents.iter())
                 .map(|run| AgentColumns::new(rec, run))
                 .collect::<Result<_, _>>()?;
+            self.paths = (agents.iter())
+                .map(|run| AgentPaths::of(&run.agent.name))
+                .collect();
         }
         for (index, ((run, state), trail)) in
             agents.iter().zip(states).zip(&mut self.points).enumerate()
         {
-            let paths = AgentPaths::of(&run.agent.name);
+            let paths = &self.paths[index];
             let p = f32x2(state.position.into());
-            log_events(rec, &paths, state)?;
+            log_events(rec, paths, state)?;
             if let Some(lidar) = &run.lidar {
                 let due = lidar.lidar.scans % LIDAR_IMAGE_EVERY == 1;
                 let new = self.fields_logged[index] != lidar.fields;
                 if state.scan.is_some() && due && new {
                     self.fields_logged[index] = lidar.fields;
                 }
-                log_lidar(rec, &paths, sim, run, state, due && new)?;
+                log_lidar(rec, paths, sim, run, state, due && new)?;
             }
             let columns = &mut self.columns[index];
             columns.push(sim.time(), run, state);
