@@ -143,24 +143,19 @@ impl Trails {
                 log_lidar(rec, paths, sim, run, state, due && new)?;
             }
             let columns = &mut self.columns[index];
-            columns.push(sim.time(), run, state);
-            if columns.full() || last {
-                columns.send(rec)?;
-            }
             trail.push(p);
             let piece = (self.steps - 1) / TRAIL_PIECE;
             let piece_ends = self.steps.is_multiple_of(TRAIL_PIECE);
             if self.steps % TRAIL_EVERY == 1 || piece_ends || last {
-                rec.log(
-                    format!("{}/{piece}", paths.trail),
-                    &rerun::LineStrips2D::new([trail.iter().copied()])
-                        .with_colors([palette::rerun(palette::BODY)])
-                        .with_radii([size::points(size::PATH)]),
-                )?;
+                columns.push_trail(piece, sim.time(), trail.clone());
             }
             if piece_ends {
                 trail.clear();
                 trail.push(p);
+            }
+            columns.push(sim.time(), run, state);
+            if columns.full() || last {
+                columns.send(rec)?;
             }
         }
         Ok(())

@@ -1,5 +1,5 @@
 //! What an agent logs every step — its body, velocity and force arrows, contact points and time
-//! series — kept in columns and sent with `send_columns` every [`COLUMN_STEPS`] steps (and when
+//! series, and the updates of its trail — kept in columns and sent with `send_columns` every [`COLUMN_STEPS`] steps (and when
 //! the recording ends): one chunk per entity and batch of steps instead of one log call per
 //! entity and step, which is what made a recording cost ten times the run.
 //!
@@ -35,6 +35,8 @@ pub struct AgentColumns {
     contact_counts: Vec<usize>,
     /// Per time series the agent has (key, values).
     series: Vec<(&'static str, Vec<f64>)>,
+    /// The trail's updates: the piece, the time and the piece's points so far.
+    trail: Vec<(usize, f64, Vec<[f32; 2]>)>,
 }
 
 impl AgentColumns {
@@ -76,6 +78,7 @@ impl AgentColumns {
             contacts: Vec::new(),
             contact_counts: Vec::new(),
             series,
+            trail: Vec::new(),
         })
     }
 
@@ -104,6 +107,11 @@ impl AgentColumns {
             debug_assert_eq!(series.key, *key);
             values.push((series.value)(&run.agent, state));
         }
+    }
+
+    /// Keeps an update of the trail's piece `piece` at `time` (s): its `points` so far.
+    pub fn push_trail(&mut self, piece: usize, time: f64, points: Vec<[f32; 2]>) {
+        self.trail.push((piece, time, points));
     }
 
     /// Whether [`COLUMN_STEPS`] steps are waiting.
@@ -159,6 +167,23 @@ impl AgentColumns {
             )?;
         }
         self.times.clear();
+        // The trail's updates, one chunk per piece.
+        let updates = std::mem::take(&mut self.trail);
+        for piece in updates.chunk_by(|a, b| a.0 == b.0) {
+            let n = piece.len();
+            rec.send_columns(
+                format!("{}/{}", self.paths.trail, piece[0].0),
+                [TimeColumn::new_duration_secs(
+                    "sim_time",
+                    piece.iter().map(|u| u.1),
+                )],
+                rerun::LineStrips2D::update_fields()
+                    .with_strips(piece.iter().map(|u| u.2.clone()))
+                    .with_colors(vec![palette::rerun(palette::BODY); n])
+                    .with_radii(vec![size::points(size::PATH); n])
+                    .columns_of_unit_batches()?,
+            )?;
+        }
         Ok(())
     }
 }

@@ -9,7 +9,7 @@
 //! - `agents/NAME/kinematic_path`, `agents/NAME/target` (static).
 //! - `agents/NAME/body`, `…/velocity`, `…/force`, `…/contacts`: per step, sent as columns
 //!   every 500 steps (`columns.rs`); `…/trail/K`: the trail in pieces of 1000 steps, each
-//!   updated every 25 steps while it grows.
+//!   updated every 25 steps while it grows (the updates sent with the columns).
 //! - `agents/NAME/events`: numerical faults and contacts as they start (text log, level WARN),
 //!   bias updates and sensing problems (level INFO).
 //! - `agents/NAME/sensed_walls`: with a noisy sensor, the outline of the configuration-space
