@@ -26,16 +26,20 @@ pub fn log_setup(
     rec: &RecordingStream,
     sim: &Simulation,
 ) -> Result<(), rerun::RecordingStreamError> {
-    for run in &sim.agents {
+    for (index, run) in sim.agents.iter().enumerate() {
         let paths = AgentPaths::of(&run.agent.name);
         if let Some(field) = run.field.harmonic() {
             let grid = *field.grid();
-            let (image, resolution) = colormap::potential_image(field);
+            // The layout shows the first agent's field; the others' (hidden, to switch on) are
+            // kept small, so a crowd's recording is not dozens of full-size images.
+            let stride = if index == 0 { 1 } else { lidar_stride(&grid) };
+            let (image, resolution) = thinned(colormap::potential_image(field), stride);
+            let scale = (grid.cell * stride as f64) as f32;
             rec.log_static(
                 paths.potential.as_str(),
                 &rerun::Transform3D::from_translation_scale(
                     [grid.origin[0] as f32, grid.origin[1] as f32, 0.0],
-                    rerun::Scale3D::from([grid.cell as f32, grid.cell as f32, 1.0]),
+                    rerun::Scale3D::from([scale, scale, 1.0]),
                 ),
             )?;
             if run.lidar.is_some() {
@@ -167,6 +171,23 @@ impl Trails {
     }
 }
 
+/// Every `stride`-th pixel of an RGB `image` of `[width, height]` pixels along both axes.
+fn thinned((image, [w, h]): (Vec<u8>, [u32; 2]), stride: usize) -> (Vec<u8>, [u32; 2]) {
+    if stride <= 1 {
+        return (image, [w, h]);
+    }
+    let (w, h) = (w as usize, h as usize);
+    let mut small = Vec::with_capacity(w.div_ceil(stride) * h.div_ceil(stride) * 3);
+    for j in (0..h).step_by(stride) {
+        for i in (0..w).step_by(stride) {
+            let k = 3 * (j * w + i);
+            small.extend_from_slice(&image[k..k + 3]);
+        }
+    }
+    let size = [w.div_ceil(stride) as u32, h.div_ceil(stride) as u32];
+    (small, size)
+}
+
 /// Cells per pixel of a lidar agent's map image: at most [`LIDAR_IMAGE`] pixels a side.
 fn lidar_stride(grid: &crate::field::Grid) -> usize {
     grid.nx.max(grid.ny).div_ceil(LIDAR_IMAGE).max(1)
@@ -231,18 +252,11 @@ fn log_lidar(
         &rerun::Image::from_rgba32(rgba, [w as u32, h as u32]).with_draw_order(-5.0),
     )?;
     if let Some(field) = run.field.harmonic() {
-        let (image, [nx, ny]) = colormap::potential_image(field);
         // At the map's resolution: this image is re-logged as the field is re-solved.
-        let mut small = Vec::with_capacity(w * h * 3);
-        for j in (0..ny as usize).step_by(step) {
-            for i in (0..nx as usize).step_by(step) {
-                let k = 3 * (j * nx as usize + i);
-                small.extend_from_slice(&image[k..k + 3]);
-            }
-        }
+        let (small, size) = thinned(colormap::potential_image(field), step);
         rec.log(
             paths.potential.as_str(),
-            &rerun::Image::from_rgb24(small, [w as u32, h as u32]).with_draw_order(-10.0),
+            &rerun::Image::from_rgb24(small, size).with_draw_order(-10.0),
         )?;
     }
     rec.log(paths.guidance.as_str(), &arrows(sim, run))?;
