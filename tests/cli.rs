@@ -568,5 +568,19 @@ fn spawn_without_a_viewer_and_a_bad_url_are_clear_errors() {
         stderr.contains("cannot stream to `http://example.com/not-a-viewer`"),
         "{stderr}"
     );
+    // Nothing listening there: said before the run (not as a failed flush when it ends).
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let url = format!("rerun+http://127.0.0.1:{port}/proxy");
+    let out = run_room(dir.path(), &["--connect", &url]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("no Rerun viewer is listening at"),
+        "{stderr}"
+    );
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }

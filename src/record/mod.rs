@@ -97,6 +97,14 @@ pub enum RecordError {
         version = rerun::build_info().version
     )]
     Spawn(String),
+    /// Nothing listens at the viewer's URL.
+    #[error(
+        "no Rerun viewer is listening at {url}: start one first (`rerun`), or let the run start one with --spawn"
+    )]
+    NoViewer {
+        /// The URL given.
+        url: String,
+    },
     /// The viewer URL is not a Rerun gRPC proxy URL.
     #[error("cannot stream to `{url}`: {message} (a viewer's URL looks like {DEFAULT_VIEWER_URL})")]
     Url {
@@ -158,6 +166,9 @@ impl Recorder {
                     Viewer::Connect(url) => url.clone(),
                 };
                 let uri = proxy_uri(&url)?;
+                if matches!(viewer, Viewer::Connect(_)) && !listening(&uri) {
+                    return Err(RecordError::NoViewer { url });
+                }
                 // Buffered until the sinks are set: the blueprint goes to both.
                 let stream = builder.buffered().map_err(stream_error(Path::new(&url)))?;
                 let grpc = rerun::sink::GrpcSink::new(uri);
@@ -262,6 +273,18 @@ impl Recorder {
             let _ = std::fs::remove_file(partial);
         }
     }
+}
+
+/// Whether something accepts connections at `uri`'s host and port (within 3 s): checked
+/// before a run that streams to it, rather than found out when the run ends.
+fn listening(uri: &rerun::external::re_uri::ProxyUri) -> bool {
+    use std::net::ToSocketAddrs;
+    let address = format!("{}:{}", uri.origin.format_host(), uri.origin.port);
+    address.to_socket_addrs().is_ok_and(|mut addresses| {
+        addresses.any(|a| {
+            std::net::TcpStream::connect_timeout(&a, std::time::Duration::from_secs(3)).is_ok()
+        })
+    })
 }
 
 /// The gRPC proxy URI of a viewer's `url`.
