@@ -7,7 +7,7 @@ use rerun::RecordingStream;
 use super::names::{AGENTS, BOX, MAP, WALLS, WORLD};
 use super::palette;
 use crate::world::map::{CellState, Occupancy};
-use crate::world::{Wall, World, drawn_walls};
+use crate::world::{World, drawn_walls, outline_box, wall_outline};
 
 /// Logs the flip, the box and the walls (static).
 pub fn log_setup(rec: &RecordingStream, world: &World) -> Result<(), rerun::RecordingStreamError> {
@@ -25,10 +25,15 @@ pub fn log_setup(rec: &RecordingStream, world: &World) -> Result<(), rerun::Reco
             [(x0 + x1) / 2.0, (y0 + y1) / 2.0],
             [(x1 - x0) / 2.0, (y1 - y0) / 2.0],
             0.0,
-        )])
+        )
+        .into_iter()
+        .map(f32x2)])
         .with_colors([palette::rerun(palette::BOX)]),
     )?;
-    let walls: Vec<Vec<[f32; 2]>> = drawn_walls(world).iter().map(outline).collect();
+    let walls: Vec<Vec<[f32; 2]>> = drawn_walls(world)
+        .iter()
+        .map(|w| wall_outline(w).into_iter().map(f32x2).collect())
+        .collect();
     rec.log_static(
         WALLS,
         &rerun::LineStrips2D::new(walls)
@@ -70,57 +75,4 @@ fn map_image(m: &Occupancy) -> Vec<u8> {
 /// A point in f32, for Rerun.
 pub fn f32x2(p: [f64; 2]) -> [f32; 2] {
     [p[0] as f32, p[1] as f32]
-}
-
-/// The closed outline of a rotated box.
-fn outline_box(center: [f64; 2], half: [f64; 2], angle: f64) -> Vec<[f32; 2]> {
-    let (s, c) = angle.sin_cos();
-    [
-        [-1.0, -1.0],
-        [1.0, -1.0],
-        [1.0, 1.0],
-        [-1.0, 1.0],
-        [-1.0, -1.0],
-    ]
-    .iter()
-    .map(|[sx, sy]| {
-        let (x, y) = (sx * half[0], sy * half[1]);
-        f32x2([center[0] + c * x - s * y, center[1] + s * x + c * y])
-    })
-    .collect()
-}
-
-/// The closed outline of a wall.
-fn outline(wall: &Wall) -> Vec<[f32; 2]> {
-    const ARC: usize = 16;
-    let arc = |center: [f64; 2], r: f64, from: f64, to: f64| -> Vec<[f32; 2]> {
-        (0..=ARC)
-            .map(|k| {
-                let a = from + (to - from) * k as f64 / ARC as f64;
-                f32x2([center[0] + r * a.cos(), center[1] + r * a.sin()])
-            })
-            .collect()
-    };
-    match wall {
-        Wall::Box {
-            center,
-            half_extents,
-            angle,
-        } => outline_box(*center, *half_extents, *angle),
-        Wall::Disc { center, radius } => arc(*center, *radius, 0.0, std::f64::consts::TAU),
-        Wall::Segment { a, b, thickness } => {
-            let r = thickness / 2.0;
-            let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
-            let half_turn = std::f64::consts::FRAC_PI_2;
-            let mut points = arc(*b, r, heading - half_turn, heading + half_turn);
-            points.extend(arc(*a, r, heading + half_turn, heading + 3.0 * half_turn));
-            points.push(points[0]);
-            points
-        }
-        Wall::Polygon { points } => {
-            let mut out: Vec<[f32; 2]> = points.iter().map(|p| f32x2(*p)).collect();
-            out.push(out[0]);
-            out
-        }
-    }
 }

@@ -6,7 +6,7 @@ use plotters::prelude::*;
 
 use super::{Outcome, Outcomes, experiments};
 use crate::chart::{PALETTE, padded, register_font};
-use crate::world::Wall;
+use crate::world::wall_outline;
 
 /// Picture size, pixels.
 const SIZE: (u32, u32) = (1000, 700);
@@ -125,44 +125,6 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
     out
 }
 
-/// The outline of a wall as a closed polygon, m.
-fn outline(wall: &Wall) -> Vec<(f64, f64)> {
-    match wall {
-        Wall::Box {
-            center,
-            half_extents,
-            angle,
-        } => {
-            let (s, c) = angle.sin_cos();
-            [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                .iter()
-                .map(|(a, b)| {
-                    let (x, y) = (a * half_extents[0], b * half_extents[1]);
-                    (center[0] + c * x - s * y, center[1] + s * x + c * y)
-                })
-                .collect()
-        }
-        Wall::Segment { a, b, thickness } => {
-            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-            let n = dx.hypot(dy).max(1e-12);
-            let (nx, ny) = (-dy / n * thickness / 2.0, dx / n * thickness / 2.0);
-            vec![
-                (a[0] + nx, a[1] + ny),
-                (b[0] + nx, b[1] + ny),
-                (b[0] - nx, b[1] - ny),
-                (a[0] - nx, a[1] - ny),
-            ]
-        }
-        Wall::Disc { center, radius } => (0..48)
-            .map(|k| {
-                let t = k as f64 * std::f64::consts::TAU / 48.0;
-                (center[0] + radius * t.cos(), center[1] + radius * t.sin())
-            })
-            .collect(),
-        Wall::Polygon { points } => points.iter().map(|p| (p[0], p[1])).collect(),
-    }
-}
-
 /// Draws `figure` from `outcomes` (which must hold its runs) as PNG bytes.
 pub fn draw(figure: &Figure, outcomes: &Outcomes) -> Result<Vec<u8>, String> {
     register_font();
@@ -234,7 +196,13 @@ pub fn draw(figure: &Figure, outcomes: &Outcomes) -> Result<Vec<u8>, String> {
             let grey = RGBColor(150, 150, 150);
             for wall in &first.world.walls {
                 chart
-                    .draw_series(std::iter::once(Polygon::new(outline(wall), grey.filled())))
+                    .draw_series(std::iter::once(Polygon::new(
+                        wall_outline(wall)
+                            .into_iter()
+                            .map(|[x, y]| (x, y))
+                            .collect::<Vec<_>>(),
+                        grey.filled(),
+                    )))
                     .map_err(e)?;
             }
             for agent in &first.world.agents {

@@ -20,7 +20,8 @@ pub use schema::{
     Replan, SensorKind, SensorSettings, UnknownCells, Wall, World,
 };
 pub use shapes::{
-    WallShape, all_wall_shapes, all_walls, drawn_walls, named_walls, outer_walls, wall_shape,
+    WallShape, all_wall_shapes, all_walls, drawn_walls, named_walls, outer_walls, outline_box,
+    wall_outline, wall_shape,
 };
 pub use validate::validate;
 

@@ -177,3 +177,58 @@ pub fn named_walls(world: &World) -> impl Iterator<Item = (String, Wall)> + '_ {
                 .map(|(i, w)| (format!("walls.{i}"), w.clone())),
         )
 }
+
+/// The closed outline of a box of half-extents `half` centred on `center`, turned by `angle`
+/// (rad), m: its four corners and the first again.
+pub fn outline_box(center: [f64; 2], half: [f64; 2], angle: f64) -> Vec<[f64; 2]> {
+    let (s, c) = angle.sin_cos();
+    [
+        [-1.0, -1.0],
+        [1.0, -1.0],
+        [1.0, 1.0],
+        [-1.0, 1.0],
+        [-1.0, -1.0],
+    ]
+    .iter()
+    .map(|[sx, sy]| {
+        let (x, y) = (sx * half[0], sy * half[1]);
+        [center[0] + c * x - s * y, center[1] + s * x + c * y]
+    })
+    .collect()
+}
+
+/// The closed outline of a wall (its first point again at the end), m: what the recording and
+/// the reproduction's figures draw. A disc is 16 chords, each round end of a segment 16 too.
+pub fn wall_outline(wall: &Wall) -> Vec<[f64; 2]> {
+    const ARC: usize = 16;
+    let arc = |center: [f64; 2], r: f64, from: f64, to: f64| -> Vec<[f64; 2]> {
+        (0..=ARC)
+            .map(|k| {
+                let a = from + (to - from) * k as f64 / ARC as f64;
+                [center[0] + r * a.cos(), center[1] + r * a.sin()]
+            })
+            .collect()
+    };
+    match wall {
+        Wall::Box {
+            center,
+            half_extents,
+            angle,
+        } => outline_box(*center, *half_extents, *angle),
+        Wall::Disc { center, radius } => arc(*center, *radius, 0.0, std::f64::consts::TAU),
+        Wall::Segment { a, b, thickness } => {
+            let r = thickness / 2.0;
+            let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
+            let half_turn = std::f64::consts::FRAC_PI_2;
+            let mut points = arc(*b, r, heading - half_turn, heading + half_turn);
+            points.extend(arc(*a, r, heading + half_turn, heading + 3.0 * half_turn));
+            points.push(points[0]);
+            points
+        }
+        Wall::Polygon { points } => {
+            let mut out = points.clone();
+            out.push(out[0]);
+            out
+        }
+    }
+}
