@@ -35,26 +35,22 @@ fn fixture(name: &str) -> std::path::PathBuf {
 
 /// Every entity path and timeline in a recording, read back with Rerun's own decoder.
 fn decode(path: &Path) -> (BTreeSet<String>, BTreeSet<String>) {
-    let rows = rows_on_sim_time(path);
-    let entities = rows.keys().cloned().collect();
-    let file = BufReader::new(std::fs::File::open(path).unwrap());
-    let messages = re_log_encoding::DecoderApp::decode_eager(file).unwrap();
-    let mut timelines = BTreeSet::new();
-    for msg in messages {
-        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
-            let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
-            timelines.extend(chunk.timelines().keys().map(|t| t.as_str().to_string()));
-        }
-    }
-    (entities, timelines)
+    let (rows, timelines) = read(path);
+    (rows.into_keys().collect(), timelines)
 }
 
 /// Per entity of a recording, how many rows it has on the `sim_time` timeline (0 for static
 /// entities).
 fn rows_on_sim_time(path: &Path) -> std::collections::BTreeMap<String, usize> {
+    read(path).0
+}
+
+/// A recording read back with Rerun's own decoder: its rows on `sim_time` per entity, and its
+/// timelines.
+fn read(path: &Path) -> (std::collections::BTreeMap<String, usize>, BTreeSet<String>) {
     let file = BufReader::new(std::fs::File::open(path).unwrap());
     let messages = re_log_encoding::DecoderApp::decode_eager(file).unwrap();
-    let mut rows = std::collections::BTreeMap::new();
+    let (mut rows, mut timelines) = (std::collections::BTreeMap::new(), BTreeSet::new());
     for msg in messages {
         if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
             let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
@@ -63,9 +59,10 @@ fn rows_on_sim_time(path: &Path) -> std::collections::BTreeMap<String, usize> {
             *rows
                 .entry(entity.trim_start_matches('/').to_string())
                 .or_insert(0) += if timed { chunk.num_rows() } else { 0 };
+            timelines.extend(chunk.timelines().keys().map(|t| t.as_str().to_string()));
         }
     }
-    rows
+    (rows, timelines)
 }
 
 #[test]

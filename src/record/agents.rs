@@ -32,7 +32,11 @@ pub fn log_setup(
             let grid = *field.grid();
             // The layout shows the first agent's field; the others' (hidden, to switch on) are
             // kept small, so a crowd's recording is not dozens of full-size images.
-            let stride = if index == 0 { 1 } else { lidar_stride(&grid) };
+            let stride = if index == 0 {
+                1
+            } else {
+                thumbnail_stride(&grid)
+            };
             let (image, resolution) = thinned(colormap::potential_image(field), stride);
             let scale = (grid.cell * stride as f64) as f32;
             rec.log_static(
@@ -45,7 +49,7 @@ pub fn log_setup(
             if run.lidar.is_some() {
                 // It changes as the map grows: logged on the timeline (log_lidar), with the
                 // map, at the map's resolution.
-                let step = lidar_stride(&grid);
+                let step = thumbnail_stride(&grid);
                 let scale = (grid.cell * step as f64) as f32;
                 for path in [&paths.known_map, &paths.potential] {
                     rec.log_static(
@@ -188,8 +192,9 @@ fn thinned((image, [w, h]): (Vec<u8>, [u32; 2]), stride: usize) -> (Vec<u8>, [u3
     (small, size)
 }
 
-/// Cells per pixel of a lidar agent's map image: at most [`LIDAR_IMAGE`] pixels a side.
-fn lidar_stride(grid: &crate::field::Grid) -> usize {
+/// Cells per pixel of a small image of `grid` (a lidar agent's map and field, another agent's
+/// field than the first): at most [`LIDAR_IMAGE`] pixels a side.
+fn thumbnail_stride(grid: &crate::field::Grid) -> usize {
     grid.nx.max(grid.ny).div_ceil(LIDAR_IMAGE).max(1)
 }
 
@@ -231,7 +236,7 @@ fn log_lidar(
         return Ok(());
     }
     let grid = *lidar.map.grid();
-    let step = lidar_stride(&grid);
+    let step = thumbnail_stride(&grid);
     let (w, h) = (grid.nx.div_ceil(step), grid.ny.div_ceil(step));
     let mut rgba = Vec::with_capacity(w * h * 4);
     for j in (0..grid.ny).step_by(step) {

@@ -9,10 +9,11 @@
 
 use rerun::{RecordingStream, TimeColumn};
 
-use super::names::{AGENT_SERIES, AgentPaths, plot};
+use super::names::{AGENT_SERIES, AgentPaths, Series, plot};
 use super::palette::{self, size};
 use super::world::f32x2;
 use crate::sim::{AgentRun, AgentState};
+use crate::world::Agent;
 
 /// Steps kept before they are sent: 5 s at the default 10 ms step. A run killed outright
 /// loses at most these from its `.partial` file.
@@ -33,8 +34,8 @@ pub struct AgentColumns {
     forces: Vec<[f32; 2]>,
     contacts: Vec<[f32; 2]>,
     contact_counts: Vec<usize>,
-    /// Per time series the agent has (key, values).
-    series: Vec<(&'static str, Vec<f64>)>,
+    /// Per time series the agent has: the series, and its values.
+    series: Vec<(&'static Series<Agent, AgentState>, Vec<f64>)>,
     /// The trail's updates: the piece, the time and the piece's points so far.
     trail: Vec<(usize, f64, Vec<[f32; 2]>)>,
 }
@@ -65,7 +66,7 @@ impl AgentColumns {
         let series = AGENT_SERIES
             .iter()
             .filter(|s| (s.shown)(&run.agent))
-            .map(|s| (s.key, Vec::new()))
+            .map(|s| (s, Vec::new()))
             .collect();
         Ok(Self {
             name: run.agent.name.clone(),
@@ -99,12 +100,7 @@ impl AgentColumns {
         self.contacts
             .extend(state.contact_points.iter().map(|c| f32x2((*c).into())));
         self.contact_counts.push(state.contact_points.len());
-        for (series, (key, values)) in AGENT_SERIES
-            .iter()
-            .filter(|s| (s.shown)(&run.agent))
-            .zip(&mut self.series)
-        {
-            debug_assert_eq!(series.key, *key);
+        for (series, values) in &mut self.series {
             values.push((series.value)(&run.agent, state));
         }
     }
@@ -159,9 +155,9 @@ impl AgentColumns {
                 .with_positions(std::mem::take(&mut self.contacts))
                 .columns(std::mem::take(&mut self.contact_counts))?,
         )?;
-        for (key, values) in &mut self.series {
+        for (series, values) in &mut self.series {
             rec.send_columns(
-                plot(&self.name, key),
+                plot(&self.name, series.key),
                 time(),
                 rerun::Scalars::new(std::mem::take(values)).columns_of_unit_batches()?,
             )?;
