@@ -19,6 +19,18 @@ pub struct Disc {
 }
 
 impl Disc {
+    /// The disc grown by `by` metres, but no further than stays clear of `agent` at `position`
+    /// on a grid of `cell` metres: a disc that comes that near is left out of the agent's
+    /// field (see [`FreeSpace::among`]), and growing must not make it vanish.
+    pub fn grown(self, by: f64, (agent, position): (&Agent, [f64; 2]), cell: f64) -> Self {
+        let distance = (position[0] - self.center[0]).hypot(position[1] - self.center[1]);
+        let room = distance - self.radius - clear_of(agent, cell);
+        Self {
+            radius: self.radius + by.min(room.max(0.0)),
+            ..self
+        }
+    }
+
     /// The disc as a wall shape, for rasterizing.
     pub fn shape(&self) -> WallShape {
         WallShape::new(
@@ -199,13 +211,19 @@ pub fn obstacle_discs<'a>(
     cell: f64,
     others: &'a [Disc],
 ) -> impl Iterator<Item = &'a Disc> + 'a {
-    let margin = agent.radius + std::f64::consts::SQRT_2 * cell;
+    let margin = clear_of(agent, cell);
     let covers = move |d: &Disc, p: [f64; 2]| {
         (p[0] - d.center[0]).hypot(p[1] - d.center[1]) < d.radius + margin
     };
     others
         .iter()
         .filter(move |d| !covers(d, agent.target) && !covers(d, position))
+}
+
+/// How far beyond its own radius a disc must stay from `agent`'s centre, on a grid of `cell`
+/// metres, to be an obstacle in its field: the agent's radius and a cell diagonal.
+fn clear_of(agent: &Agent, cell: f64) -> f64 {
+    agent.radius + std::f64::consts::SQRT_2 * cell
 }
 
 /// The `reachable` cells whose centres are within `radius` of `center` (the cell of `center`

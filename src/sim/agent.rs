@@ -321,16 +321,15 @@ impl AgentRun {
             // (An attractive-repulsive field sees them anew every step.)
             let replanned = replan_hz > 0.0 && self.field.harmonic().is_some();
             let horizon = if replanned { 1.0 / replan_hz } else { 0.0 };
-            let margin = std::f64::consts::SQRT_2 * world.field.cell;
             plan.others = others
                 .iter()
                 .map(|n| {
-                    let room = (n.position - x).norm() - n.radius - self.agent.radius - margin;
-                    let grow = (n.velocity.norm() * horizon).min(room.max(0.0));
-                    Disc {
+                    let disc = Disc {
                         center: n.position.into(),
-                        radius: n.radius + grow,
-                    }
+                        radius: n.radius,
+                    };
+                    let by = n.velocity.norm() * horizon;
+                    disc.grown(by, (&self.agent, x.into()), world.field.cell)
                 })
                 .collect();
         }
