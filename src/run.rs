@@ -135,7 +135,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
     let mut recorder = match (&options.recording, &options.viewer) {
         (None, None) => None,
         (path, viewer) => {
-            let mut r = Recorder::create_to(path.as_deref(), viewer.as_ref(), world)?;
+            let mut r = Recorder::create(path.as_deref(), viewer.as_ref(), world)?;
             if let Err(e) = r.log_setup(&sim) {
                 r.abandon();
                 return Err(e.into());

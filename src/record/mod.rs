@@ -133,14 +133,10 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// Starts the recording of `world` that will end up at `path`.
-    pub fn create(path: &Path, world: &World) -> Result<Self, RecordError> {
-        Self::create_to(Some(path), None, world)
-    }
-
     /// Starts the recording of `world` into the file `path` (if any) and the `viewer` (if
-    /// any): a viewer is started, or the URL checked, before anything is simulated.
-    pub fn create_to(
+    /// any; with neither, nothing is recorded): a viewer is started, or its URL checked, before
+    /// anything is simulated.
+    pub fn create(
         path: Option<&Path>,
         viewer: Option<&Viewer>,
         world: &World,
