@@ -2,7 +2,7 @@
 
 mod common;
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::io::BufReader;
 use std::path::Path;
 use std::process::Command;
@@ -35,34 +35,120 @@ fn fixture(name: &str) -> std::path::PathBuf {
 
 /// Every entity path and timeline in a recording, read back with Rerun's own decoder.
 fn decode(path: &Path) -> (BTreeSet<String>, BTreeSet<String>) {
-    let (rows, timelines) = read(path);
-    (rows.into_keys().collect(), timelines)
+    let recording = Recording::read(path);
+    (recording.rows.into_keys().collect(), recording.timelines)
 }
 
-/// Per entity of a recording, how many rows it has on the `sim_time` timeline (0 for static
-/// entities).
-fn rows_on_sim_time(path: &Path) -> std::collections::BTreeMap<String, usize> {
-    read(path).0
+/// A recording read back with Rerun's own decoder.
+struct Recording {
+    /// Per entity, per component (`Archetype:field`), its rows on the `sim_time` timeline (0
+    /// for a static one).
+    rows: BTreeMap<String, BTreeMap<String, usize>>,
+    timelines: BTreeSet<String>,
+    /// The entity paths of its layout (its blueprint store).
+    layout: BTreeSet<String>,
+    /// The recording's chunks (not the layout's).
+    chunks: Vec<re_chunk::Chunk>,
 }
 
-/// A recording read back with Rerun's own decoder: its rows on `sim_time` per entity, and its
-/// timelines.
-fn read(path: &Path) -> (std::collections::BTreeMap<String, usize>, BTreeSet<String>) {
-    let file = BufReader::new(std::fs::File::open(path).unwrap());
-    let messages = re_log_encoding::DecoderApp::decode_eager(file).unwrap();
-    let (mut rows, mut timelines) = (std::collections::BTreeMap::new(), BTreeSet::new());
-    for msg in messages {
-        if let re_log_types::LogMsg::ArrowMsg(_, arrow) = msg.unwrap() {
+impl Recording {
+    fn read(path: &Path) -> Self {
+        let file = BufReader::new(std::fs::File::open(path).unwrap());
+        let messages = re_log_encoding::DecoderApp::decode_eager(file).unwrap();
+        let mut recording = Recording {
+            rows: BTreeMap::new(),
+            timelines: BTreeSet::new(),
+            layout: BTreeSet::new(),
+            chunks: Vec::new(),
+        };
+        for msg in messages {
+            let re_log_types::LogMsg::ArrowMsg(store, arrow) = msg.unwrap() else {
+                continue;
+            };
             let chunk = re_chunk::Chunk::from_arrow_msg(&arrow).unwrap();
             let entity = chunk.entity_path().to_string();
+            let entity = entity.trim_start_matches('/').to_string();
+            if store.kind() == re_log_types::StoreKind::Blueprint {
+                recording.layout.insert(entity);
+                continue;
+            }
             let timed = chunk.timelines().keys().any(|t| t.as_str() == "sim_time");
-            *rows
-                .entry(entity.trim_start_matches('/').to_string())
-                .or_insert(0) += if timed { chunk.num_rows() } else { 0 };
-            timelines.extend(chunk.timelines().keys().map(|t| t.as_str().to_string()));
+            let components = recording.rows.entry(entity).or_default();
+            for component in chunk.components_identifiers() {
+                *components.entry(component.to_string()).or_insert(0) +=
+                    if timed { chunk.num_rows() } else { 0 };
+            }
+            recording
+                .timelines
+                .extend(chunk.timelines().keys().map(|t| t.as_str().to_string()));
+            recording.chunks.push(chunk);
         }
+        recording
     }
-    (rows, timelines)
+
+    /// The rows of `entity`'s `component` on `sim_time`.
+    fn rows(&self, entity: &str, component: &str) -> usize {
+        self.rows
+            .get(entity)
+            .and_then(|c| c.get(component))
+            .copied()
+            .unwrap_or(0)
+    }
+
+    /// The labels of the series of the plot `entity`.
+    fn labels(&self, entity: &str) -> Vec<String> {
+        (self.chunks.iter())
+            .filter(|c| c.entity_path().to_string().trim_start_matches('/') == entity)
+            .flat_map(|c| {
+                c.iter_slices::<String>("SeriesLines:names".into())
+                    .flatten()
+            })
+            .map(|label| label.to_string())
+            .collect()
+    }
+
+    /// The rows of `entity`'s `component` on `sim_time`, in time order: (time in ns, the row's
+    /// numbers). `N` is 0 for a component of `f64`s, or the size of its `f32` arrays; `strips`
+    /// reads a line strip's points (`[f32; 2]`).
+    fn values<const N: usize>(
+        &self,
+        entity: &str,
+        component: &'static str,
+    ) -> Vec<(i64, Vec<f64>)> {
+        let mut rows = Vec::new();
+        for chunk in &self.chunks {
+            if chunk.entity_path().to_string().trim_start_matches('/') != entity {
+                continue;
+            }
+            let id = component.into();
+            let times = chunk.iter_component_indices("sim_time".into(), id);
+            let numbers: Vec<Vec<f64>> = if component.ends_with(":strips") {
+                chunk
+                    .iter_slices::<&[[f32; 2]]>(id)
+                    .map(|strips| {
+                        strips
+                            .iter()
+                            .flat_map(|s| s.iter().flatten())
+                            .map(|&x| f64::from(x))
+                            .collect()
+                    })
+                    .collect()
+            } else if N == 0 {
+                chunk
+                    .iter_slices::<f64>(id)
+                    .map(|row| row.to_vec())
+                    .collect()
+            } else {
+                chunk
+                    .iter_slices::<[f32; N]>(id)
+                    .map(|row| row.iter().flatten().map(|&x| f64::from(x)).collect())
+                    .collect()
+            };
+            rows.extend(times.map(|(t, _)| t.as_i64()).zip(numbers));
+        }
+        rows.sort_by_key(|r| r.0);
+        rows
+    }
 }
 
 #[test]
@@ -86,7 +172,7 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
         "{stdout}"
     );
 
-    let (entities, timelines) = decode(&rrd);
+    let recording = Recording::read(&rrd);
     for e in [
         "world/box",
         "world/walls",
@@ -95,33 +181,62 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
         "agents/robot/kinematic_path",
         "agents/robot/target",
         "agents/robot/body",
-        "agents/robot/trail/0",
-        "agents/robot/velocity",
-        "agents/robot/force",
+        "agents/robot/trail",
+        "agents/robot/body/velocity",
+        "agents/robot/body/force",
         "agents/robot/contacts",
         "plots/robot/distance",
         "plots/robot/speed",
-        "plots/robot/radial_speed",
         "plots/robot/force",
-        "plots/robot/force_x",
-        "plots/robot/force_y",
         "plots/robot/potential",
     ] {
-        assert!(entities.contains(e), "no `{e}` in {entities:?}");
+        assert!(
+            recording.rows.contains_key(e),
+            "no `{e}` in {:?}",
+            recording.rows.keys()
+        );
     }
-    assert!(timelines.contains("sim_time"), "{timelines:?}");
-    // Every step of the 8 s is there, though sent in columns of 500 steps (the last 300 when
-    // the run ended): the body, its arrows and contacts, and every series.
-    let rows = rows_on_sim_time(&rrd);
-    for e in [
-        "agents/robot/body",
-        "agents/robot/velocity",
-        "agents/robot/force",
-        "agents/robot/contacts",
-        "plots/robot/distance",
-        "plots/robot/potential",
+    assert!(recording.timelines.contains("sim_time"));
+    // Every step of the 8 s is there: where the body is and its arrows.
+    for (e, component) in [
+        ("agents/robot/body", "Transform3D:translation"),
+        ("agents/robot/body/velocity", "Arrows2D:vectors"),
+        ("agents/robot/body/force", "Arrows2D:vectors"),
     ] {
-        assert_eq!(rows[e], 800, "{e}");
+        assert_eq!(recording.rows(e, component), 800, "{e}");
+    }
+    let body = recording.values::<3>("agents/robot/body", "Transform3D:translation");
+    // The trail: 32 segments of 25 steps, each starting where the one before ended, together
+    // every position once.
+    let segments = recording.values::<2>("agents/robot/trail", "LineStrips2D:strips");
+    assert_eq!(segments.len(), 32);
+    let mut trail: Vec<f64> = Vec::new();
+    for (k, (_, points)) in segments.iter().enumerate() {
+        if k > 0 {
+            assert_eq!(
+                points[..2],
+                trail[trail.len() - 2..],
+                "segment {k} is not joined"
+            );
+        }
+        trail.extend_from_slice(&points[if k == 0 { 0 } else { 2 }..]);
+    }
+    let positions: Vec<f64> = body.iter().flat_map(|(_, p)| [p[0], p[1]]).collect();
+    assert_eq!(trail, positions);
+    // A plot keeps the rows where its value changes: at every step, its latest row is the
+    // distance from where the body is to the target (f32 positions: within 1e-4 m).
+    let distance = recording.values::<0>("plots/robot/distance", "Scalars:scalars");
+    assert!(distance.len() > 1 && distance.len() <= 800);
+    let world = nadf::world::load(&world_path("room-two-dividers.toml"), &[]).unwrap();
+    let target = world.agents[0].target;
+    for (t, p) in &body {
+        let latest = distance.iter().rev().find(|(s, _)| s <= t).expect("a row");
+        let d = (p[0] - target[0]).hypot(p[1] - target[1]);
+        assert!(
+            (latest.1[0] - d).abs() < 1e-4,
+            "at {t} ns: {} against {d}",
+            latest.1[0]
+        );
     }
     // Only the finished files are left: no `.partial`.
     let mut names: Vec<String> = std::fs::read_dir(dir.path())
@@ -326,26 +441,33 @@ fn field_exports_numpy_arrays_and_a_picture() {
 #[test]
 fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
     let dir = tempfile::tempdir().unwrap();
+    // An entity, or `ENTITY[LABEL]`: a series of that plot.
     let cases: [(&str, &[&str], &[&str]); 8] = [
         (
             "room-speed-limit.toml",
-            &["plots/robot/speed_limited", "summary"],
-            &["plots/robot/clamping", "plots/robot/beta_x"],
+            &["plots/robot/limits[speed limit active]", "summary"],
+            &["plots/robot/limits[clamping active]", "plots/robot/bias"],
         ),
         (
             "room-drift-bias.toml",
             &[
-                "plots/robot/clamping",
-                "plots/robot/beta_x",
-                "plots/robot/beta_y",
+                "plots/robot/limits[clamping active]",
+                "plots/robot/bias[β x (N)]",
+                "plots/robot/bias[β y (N)]",
                 "agents/robot/events",
             ],
-            &["plots/robot/speed_limited", "agents/robot/sensed_walls"],
+            &[
+                "plots/robot/limits[speed limit active]",
+                "agents/robot/sensed_walls",
+            ],
         ),
         (
             "room-drift-noise.toml",
-            &["plots/robot/clamping", "agents/robot/sensed_walls"],
-            &["plots/robot/beta_x"],
+            &[
+                "plots/robot/limits[clamping active]",
+                "agents/robot/sensed_walls",
+            ],
+            &["plots/robot/bias"],
         ),
         (
             "pendulum-bias.toml",
@@ -353,9 +475,10 @@ fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
                 "world/pendulums/pendulum/rod",
                 "world/pendulums/pendulum/bob",
                 "world/pendulums/pendulum/events",
-                "plots/pendulum/theta",
+                "plots/pendulum/theta[θ (rad)]",
+                "plots/pendulum/theta[θ_T (rad)]",
                 "plots/pendulum/torque",
-                "plots/pendulum/beta",
+                "plots/pendulum/bias",
             ],
             &["agents/robot/body"],
         ),
@@ -407,13 +530,43 @@ fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
             ],
         );
         common::assert_success(&out);
-        let (entities, _) = decode(&dir.path().join("r.rrd"));
+        let recording = Recording::read(&dir.path().join("r.rrd"));
+        let has = |e: &str| match e.split_once('[') {
+            Some((entity, label)) => recording
+                .labels(entity)
+                .contains(&label.trim_end_matches(']').to_string()),
+            None => recording.rows.contains_key(e),
+        };
         for e in present {
-            assert!(entities.contains(*e), "{world}: no `{e}` in {entities:?}");
+            assert!(has(e), "{world}: no `{e}` in {:?}", recording.rows.keys());
         }
         for e in absent {
-            assert!(!entities.contains(*e), "{world}: unexpected `{e}`");
+            assert!(!has(e), "{world}: unexpected `{e}`");
         }
+        // The layout: every plot view shows the whole run (its time axis is set), every
+        // agent's trail shows up to the cursor, and a world far longer than wide (the corridor)
+        // has a second view that follows the agent, with its bounds; the room has not.
+        let set = |suffix: &str| {
+            (recording.layout.iter())
+                .filter(|e| e.ends_with(suffix))
+                .count()
+        };
+        // One view per plot, whoever has it.
+        let plots = (recording.rows.keys())
+            .filter_map(|e| {
+                e.strip_prefix("plots/")?
+                    .split_once('/')
+                    .map(|(_, key)| key)
+            })
+            .collect::<BTreeSet<_>>()
+            .len();
+        assert_eq!(set("/TimeAxis"), plots, "{world}: {:?}", recording.layout);
+        let trails = (recording.rows.keys())
+            .filter(|e| e.ends_with("/trail"))
+            .count();
+        let follows = usize::from(world.starts_with("corridor"));
+        assert_eq!(set("/trail/visualizers"), trails * (1 + follows), "{world}");
+        assert_eq!(set("/VisualBounds2D"), follows, "{world}");
     }
 }
 
@@ -511,9 +664,7 @@ fn connect_streams_the_run_to_a_running_viewer() {
     // The viewer writes what it receives as it comes: wait for the last step's columns.
     let has_run = |path: &Path| {
         path.exists()
-            && rows_on_sim_time(path)
-                .get("agents/robot/body")
-                .is_some_and(|rows| *rows == 800)
+            && Recording::read(path).rows("agents/robot/body", "Transform3D:translation") == 800
     };
     let started = std::time::Instant::now();
     while !has_run(&received) && started.elapsed().as_secs() < 30 {

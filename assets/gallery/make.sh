@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates the gallery (assets/gallery/*.png): runs a small room, the corridor, the two
-# largest map worlds and a crowd, and renders each recording as a new user first sees it, with
+# Regenerates the gallery (assets/gallery/*.png): runs a small room, the corridor, a 192 m map
+# world, the maze and a crowd, and renders each recording as a new user first sees it, with
 # the Rerun viewer headless (`rerun FILE --headless --screenshot-to`). Needs the viewer that matches the
 # SDK (`pip install rerun-sdk==0.36.3`) and a Vulkan driver (a software one, Debian's
 # `mesa-vulkan-drivers`, is enough). Pillow, when installed, halves the screenshots' HiDPI size.
@@ -9,7 +9,7 @@ cd "$(dirname "$0")/../.."
 out=assets/gallery
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-for world in room-two-dividers corridor-obstruction map-arena map-maze crowds/circle-16; do
+for world in room-two-dividers corridor-obstruction map-arena-200 map-maze crowds/circle-16; do
     name=$(basename "$world")
     echo "gallery: $world"
     # A world whose expectations fail still writes its recording (exit 1): it is shown as it is.

@@ -6,22 +6,15 @@ use rerun::RecordingStream;
 
 use super::colormap;
 use super::columns::AgentColumns;
-use super::names::{AGENT_SERIES, AgentPaths, plot};
+use super::names::{AgentPaths, SIM_TIME};
 use super::palette::{self, size};
 use super::world::f32x2;
 use crate::sim::{AgentRun, AgentState, Simulation};
 
-/// Steps between two updates of the trail.
-const TRAIL_EVERY: usize = 25;
-/// Steps per piece of the trail: the trail is logged in pieces, `…/trail/0`, `…/trail/1`, …,
-/// each re-logged as it grows (every [`TRAIL_EVERY`] steps) and then left alone, so the trail
-/// up to any instant shows in the viewer and the recording grows linearly with the run.
-const TRAIL_PIECE: usize = 1000;
 /// Arrows shown per side of the box in the guidance arrow field.
 const GUIDANCE_ARROWS: usize = 24;
 
-/// Logs each agent's field, guidance, kinematic path, start, target and series' labels
-/// (static).
+/// Logs each agent's field, guidance, kinematic path, start and target (static).
 pub fn log_setup(
     rec: &RecordingStream,
     sim: &Simulation,
@@ -90,33 +83,23 @@ pub fn log_setup(
                 .with_radii([size::points(size::MARKER)])
                 .with_colors([palette::rerun(palette::START)]),
         )?;
-        for series in AGENT_SERIES.iter().filter(|s| (s.shown)(&run.agent)) {
-            rec.log_static(
-                plot(&run.agent.name, series.key),
-                &rerun::SeriesLines::new().with_names([series.label]),
-            )?;
-        }
     }
     Ok(())
 }
 
-/// The agents' trails, and the per-step values waiting to be sent as columns.
+/// What the agents log every step: their columns (made at the first step), and which lidar
+/// field each last logged.
 #[derive(Default)]
-pub struct Trails {
-    /// Per agent, the points of the trail's current piece (its first point is the last of the
-    /// piece before).
-    points: Vec<Vec<[f32; 2]>>,
-    /// Per agent, its columns and its entity paths (made at the first step).
+pub struct Steps {
     columns: Vec<AgentColumns>,
     paths: Vec<AgentPaths>,
-    steps: usize,
     /// Per agent, the lidar field last logged (`LidarRun::fields`).
     fields_logged: Vec<usize>,
 }
 
-impl Trails {
-    /// Logs each agent's state after a step; `last` is the run's last step (the trail and the
-    /// columns are then logged whatever the count).
+impl Steps {
+    /// Logs each agent's state after a step; `last` is the run's last step (the columns are
+    /// then sent whatever they hold).
     pub fn log_step(
         &mut self,
         rec: &RecordingStream,
@@ -125,8 +108,6 @@ impl Trails {
         last: bool,
     ) -> Result<(), rerun::RecordingStreamError> {
         let agents = &sim.agents;
-        self.steps += 1;
-        self.points.resize(agents.len(), Vec::new());
         self.fields_logged.resize(agents.len(), 0);
         if self.columns.is_empty() {
             self.columns = (agents.iter())
@@ -136,12 +117,9 @@ impl Trails {
                 .map(|run| AgentPaths::of(&run.agent.name))
                 .collect();
         }
-        for (index, ((run, state), trail)) in
-            agents.iter().zip(states).zip(&mut self.points).enumerate()
-        {
+        for (index, (run, state)) in agents.iter().zip(states).enumerate() {
             let paths = &self.paths[index];
-            let p = f32x2(state.position.into());
-            log_events(rec, paths, state)?;
+            log_events(rec, sim.time(), paths, state)?;
             if let Some(lidar) = &run.lidar {
                 let due = lidar.lidar.scans % LIDAR_IMAGE_EVERY == 1;
                 let new = self.fields_logged[index] != lidar.fields;
@@ -151,27 +129,22 @@ impl Trails {
                 log_lidar(rec, paths, sim, run, state, due && new)?;
             }
             let columns = &mut self.columns[index];
-            trail.push(p);
-            let piece = (self.steps - 1) / TRAIL_PIECE;
-            let piece_ends = self.steps.is_multiple_of(TRAIL_PIECE);
-            if self.steps % TRAIL_EVERY == 1 || piece_ends || last {
-                columns.push_trail(piece, sim.time(), trail.clone());
-            }
-            if piece_ends {
-                trail.clear();
-                trail.push(p);
-            }
             columns.push(sim.time(), run, state);
             if columns.full() || last {
-                columns.send(rec)?;
+                columns.send(rec, last)?;
             }
         }
         Ok(())
     }
 
-    /// Sends the per-step values still waiting (the run was interrupted before its last step).
-    pub fn flush(&mut self, rec: &RecordingStream) -> Result<(), rerun::RecordingStreamError> {
-        self.columns.iter_mut().try_for_each(|c| c.send(rec))
+    /// Sends the per-step values waiting; with `end`, the recording ends here (the run was
+    /// interrupted, or has ended).
+    pub fn send(
+        &mut self,
+        rec: &RecordingStream,
+        end: bool,
+    ) -> Result<(), rerun::RecordingStreamError> {
+        self.columns.iter_mut().try_for_each(|c| c.send(rec, end))
     }
 }
 
@@ -220,6 +193,7 @@ fn log_lidar(
     let (Some(lidar), Some(beams)) = (&run.lidar, &state.scan) else {
         return Ok(());
     };
+    rec.set_duration_secs(SIM_TIME, sim.time());
     let every = beams.len().div_ceil(LIDAR_RAYS_SHOWN).max(1);
     let rays: Vec<[[f32; 2]; 2]> = beams
         .iter()
@@ -279,12 +253,18 @@ fn arrows(sim: &Simulation, run: &AgentRun) -> rerun::Arrows2D {
         )])
 }
 
-/// The agent's events of the step (WARN) and notes (INFO), and the walls its sensor saw.
+/// The agent's events of the step that ended at `time` (WARN) and notes (INFO), and the walls
+/// its sensor saw.
 fn log_events(
     rec: &RecordingStream,
+    time: f64,
     paths: &AgentPaths,
     state: &AgentState,
 ) -> Result<(), rerun::RecordingStreamError> {
+    if state.events.is_empty() && state.notes.is_empty() && state.sensed_walls.is_none() {
+        return Ok(());
+    }
+    rec.set_duration_secs(SIM_TIME, time);
     for (messages, level) in [
         (&state.events, rerun::TextLogLevel::WARN),
         (&state.notes, rerun::TextLogLevel::INFO),

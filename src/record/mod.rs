@@ -7,9 +7,13 @@
 //!   grey, free cells the target cannot be reached from are black.
 //! - `agents/NAME/field/guidance`: a sparse arrow field of the unit guidance `-∇V/|∇V|` (static).
 //! - `agents/NAME/kinematic_path`, `agents/NAME/target` (static).
-//! - `agents/NAME/body`, `…/velocity`, `…/force`, `…/contacts`: per step, sent as columns
-//!   every 500 steps (`columns.rs`); `…/trail/K`: the trail in pieces of 1000 steps, each
-//!   updated every 25 steps while it grows (the updates sent with the columns).
+//! - `agents/NAME/body`: a frame that moves with the agent (its translation per step is the
+//!   agent's position, turned y-down so a view rooted there shows the world upright) with the
+//!   disc at its origin (its colour changes while it touches something); `…/body/velocity`,
+//!   `…/body/force`: the arrows, in that frame; `agents/NAME/contacts`: where it touches; all
+//!   per step, sent as columns (`columns.rs`).
+//! - `agents/NAME/trail`: the path so far, a segment of 25 steps at a time (the layout shows
+//!   every segment up to the time cursor).
 //! - `agents/NAME/events`: numerical faults and contacts as they start (text log, level WARN),
 //!   bias updates and sensing problems (level INFO).
 //! - `agents/NAME/sensed_walls`: with a noisy sensor, the outline of the configuration-space
@@ -17,13 +21,15 @@
 //! - `agents/NAME/lidar/scan` (every scan, some of its rays) and `agents/NAME/lidar/map` (once a
 //!   second at 10 Hz: occupied black, free translucent white, unknown clear): with a lidar; its
 //!   `field/potential` is then re-logged with the map, as the field is re-solved on it.
-//! - `plots/NAME/{distance, speed, radial_speed, force, force_x, force_y, potential}`: scalars.
-//! - `plots/NAME/{clamping, speed_limited}` (0 or 1) and `plots/NAME/{beta_x, beta_y}` (N):
-//!   when the agent's controller has a clamp, a speed limit or a bias.
+//! - `plots/NAME/KEY`: one entity per plot, with one scalar per series, in order: `distance`;
+//!   `speed` (speed, speed along the guidance, m/s); `force` (|F|, Fx, Fy, N); `potential`;
+//!   `limits` (clamping active, speed limit active: 0 or 1, those the controller has); `bias`
+//!   (β x, β y, N; with a bias). A plot keeps only the rows that start or end a run of equal
+//!   values (`columns::Runs`): a flag's plot is a few rows, not one a step.
 //!
 //! - `summary`: the run's verdict (the summary table and the expectations), a text document.
 //! - `world/pendulums/NAME/{pivot, target, rod, bob}`: a pendulum; `…/events` its bias updates
-//!   (INFO); `plots/NAME/{theta, target, torque, beta}`: θ(t), θ_T, u(t) and β(t).
+//!   (INFO); `plots/NAME/{theta, torque, bias}`: (θ(t), θ_T), u(t) and β(t).
 //!
 //! Time is the `sim_time` timeline, in seconds. The world is y-up while Rerun's 2D views are
 //! y-down, so `world` and `agents` carry a static transform that flips y about the box.
@@ -45,6 +51,7 @@ mod pendulums;
 mod picture;
 mod world;
 
+pub use columns::Runs;
 pub use picture::field_picture;
 
 use std::path::{Path, PathBuf};
@@ -68,8 +75,9 @@ pub const DEFAULT_VIEWER_URL: &str = rerun::DEFAULT_CONNECT_URL;
 use crate::sim::{AgentState, Simulation};
 use crate::world::World;
 
-/// Wall-clock time between two flushes of the file, so that a run killed outright still leaves
-/// a `.partial` file that decodes up to its last few seconds.
+/// Wall-clock time between two flushes of the stream (the steps kept in columns are sent
+/// first), so that a viewer shows a run as it goes and a run killed outright still leaves a
+/// `.partial` file that decodes up to its last second.
 const FLUSH_EVERY: std::time::Duration = std::time::Duration::from_secs(1);
 
 /// Why a recording could not be written.
@@ -126,9 +134,11 @@ pub enum RecordError {
 /// Streams a run into an `.rrd` file, a Rerun viewer, or both.
 pub struct Recorder {
     stream: RecordingStream,
+    /// The layout, made while the recording is set up (sent at the end of [`Self::log_setup`]).
+    layout: Option<blueprint::Prepared>,
     /// The file being written and where it goes when it is complete, if any.
     file: Option<(PathBuf, PathBuf)>,
-    trails: agents::Trails,
+    steps: agents::Steps,
     last_flush: std::time::Instant,
 }
 
@@ -141,17 +151,16 @@ impl Recorder {
         viewer: Option<&Viewer>,
         world: &World,
     ) -> Result<Self, RecordError> {
+        let layout = (path.is_some() || viewer.is_some()).then(|| blueprint::prepare(world));
         let file = path.map(|p| (crate::output::partial_path(p), p.to_path_buf()));
-        let builder = RecordingStreamBuilder::new("nadf")
-            .recording_name(world.name())
-            .with_blueprint(blueprint::layout(world));
+        let builder = RecordingStreamBuilder::new("nadf").recording_name(world.name());
         let stream_error = |path: &Path| {
             let path = path.to_path_buf();
             move |source| RecordError::Stream { path, source }
         };
         let stream = match (viewer, &file) {
             (None, Some((partial, _))) => builder.save(partial).map_err(stream_error(partial))?,
-            (None, None) => RecordingStream::disabled(),
+            (None, None) => return Ok(Self::disabled()),
             (Some(viewer), file) => {
                 let url = match viewer {
                     Viewer::Spawn => {
@@ -165,7 +174,7 @@ impl Recorder {
                 if matches!(viewer, Viewer::Connect(_)) && !listening(&uri) {
                     return Err(RecordError::NoViewer { url });
                 }
-                // Buffered until the sinks are set: the blueprint goes to both.
+                // Buffered until the sinks are set.
                 let stream = builder.buffered().map_err(stream_error(Path::new(&url)))?;
                 let grpc = rerun::sink::GrpcSink::new(uri);
                 match file {
@@ -185,30 +194,48 @@ impl Recorder {
         };
         Ok(Self {
             stream,
+            layout,
             file,
-            trails: agents::Trails::default(),
+            steps: agents::Steps::default(),
             last_flush: std::time::Instant::now(),
         })
+    }
+
+    /// A recorder that records nothing.
+    fn disabled() -> Self {
+        Self {
+            stream: RecordingStream::disabled(),
+            layout: None,
+            file: None,
+            steps: agents::Steps::default(),
+            last_flush: std::time::Instant::now(),
+        }
     }
 
     /// Logs everything that does not change during the run: geometry, fields, kinematic paths.
     pub fn log_setup(&mut self, sim: &Simulation) -> Result<(), rerun::RecordingStreamError> {
         world::log_setup(&self.stream, &sim.world)?;
         pendulums::log_setup(&self.stream, &sim.pendulums)?;
-        agents::log_setup(&self.stream, sim)
+        agents::log_setup(&self.stream, sim)?;
+        match self.layout.take() {
+            Some(layout) => blueprint::send(&self.stream, layout),
+            None => Ok(()),
+        }
     }
 
-    /// Logs the state of every body after a step, at the simulation's time.
+    /// Logs the state of every body after a step, at the simulation's time. (What is logged
+    /// every step goes in columns with their own times; the stream's time is set only before
+    /// the rare things logged as they happen, as setting it costs more than keeping a row.)
     pub fn log_step(
         &mut self,
         sim: &Simulation,
         states: &[AgentState],
     ) -> Result<(), rerun::RecordingStreamError> {
         let rec = &self.stream;
-        rec.set_duration_secs("sim_time", sim.time());
-        pendulums::log_step(rec, &sim.pendulums)?;
-        self.trails.log_step(rec, sim, states, sim.finished())?;
+        pendulums::log_step(rec, sim.time(), &sim.pendulums)?;
+        self.steps.log_step(rec, sim, states, sim.finished())?;
         if self.last_flush.elapsed() >= FLUSH_EVERY {
+            self.steps.send(rec, false)?;
             // A failed flush is not fatal here: the next one, or the footer, retries.
             let _ = self.stream.flush_blocking();
             self.last_flush = std::time::Instant::now();
@@ -232,11 +259,11 @@ impl Recorder {
         let Self {
             stream,
             file,
-            mut trails,
+            mut steps,
             ..
         } = self;
-        let flushed = trails
-            .flush(&stream)
+        let flushed = steps
+            .send(&stream, true)
             .map_err(|e| e.to_string())
             .and_then(|()| stream.flush_blocking().map_err(|e| e.to_string()));
         if let Err(message) = flushed {

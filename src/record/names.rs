@@ -6,6 +6,9 @@ use crate::sim::AgentState;
 use crate::sim::pendulum::PendulumState;
 use crate::world::{Agent, Pendulum};
 
+/// The timeline of the simulation's time, s.
+pub const SIM_TIME: &str = "sim_time";
+
 /// The root of the static geometry.
 pub const WORLD: &str = "world";
 /// The box's outline.
@@ -20,9 +23,9 @@ pub const AGENTS: &str = "agents";
 /// The run's verdict as a text document: the summary table and the expectations' results.
 pub const SUMMARY: &str = "summary";
 
-/// The time series of `owner` (an agent or a pendulum) called `series`.
-pub fn plot(owner: &str, series: &str) -> String {
-    format!("plots/{owner}/{series}")
+/// The plot `key` of `owner` (an agent or a pendulum).
+pub fn plot(owner: &str, key: &str) -> String {
+    format!("plots/{owner}/{key}")
 }
 
 /// One agent's entities.
@@ -37,13 +40,15 @@ pub struct AgentPaths {
     pub target: String,
     /// Its start.
     pub start: String,
-    /// Its body, per step.
+    /// Its body: a frame that moves with it (a translation per step, flipped to y-down so that
+    /// a view rooted there, which follows the agent, shows the world upright) with its disc at
+    /// the frame's origin.
     pub body: String,
     /// Its trail.
     pub trail: String,
-    /// Its velocity arrow.
+    /// Its velocity arrow, in the body's frame.
     pub velocity: String,
-    /// Its control force arrow.
+    /// Its control force arrow, in the body's frame.
     pub force: String,
     /// Where it touches something.
     pub contacts: String,
@@ -69,8 +74,8 @@ impl AgentPaths {
             start: path("start"),
             body: path("body"),
             trail: path("trail"),
-            velocity: path("velocity"),
-            force: path("force"),
+            velocity: path("body/velocity"),
+            force: path("body/force"),
             contacts: path("contacts"),
             events: path("events"),
             sensed_walls: path("sensed_walls"),
@@ -113,15 +118,48 @@ impl PendulumPaths {
     }
 }
 
-/// A time series: its name under `plots/OWNER/`, its label, the view it is shown in, whether
-/// an owner has it, and its value after a step.
-pub struct Series<Owner, State> {
+/// A time-series plot of an owner (an agent or a pendulum): the entity `plots/OWNER/KEY`, one
+/// view in the layout, and one scalar per series the owner has, sent together in one row a step
+/// (one row for the force's three components, not three: rows, not values, are most of a long
+/// recording's size).
+pub struct Plot<Owner: 'static, State: 'static> {
     /// The entity name under `plots/OWNER/`.
     pub key: &'static str,
+    /// The title of its time-series view.
+    pub view: &'static str,
+    /// Its series, in the order of the row's scalars.
+    pub series: &'static [Series<Owner, State>],
+    /// Whether its series hold their values between jumps (flags, a bias): their rows are
+    /// mostly the ends of runs of equal values (`columns::Runs`), so the plot is drawn without
+    /// the viewer's aggregation of the points that share a pixel, which would average a jump
+    /// and draw a slope from it to the next row a minute later.
+    pub piecewise_constant: bool,
+}
+
+impl<Owner, State> Plot<Owner, State> {
+    /// How the plot's series with `labels` are drawn.
+    pub fn lines<'a>(&self, labels: impl IntoIterator<Item = &'a str>) -> rerun::SeriesLines {
+        let lines = rerun::SeriesLines::new().with_names(labels);
+        if self.piecewise_constant {
+            lines.with_aggregation_policy(rerun::components::AggregationPolicy::Off)
+        } else {
+            lines
+        }
+    }
+
+    /// The series `owner` has (from its settings), in order: the scalars of the plot's rows.
+    pub fn series_of<'a>(
+        &'a self,
+        owner: &'a Owner,
+    ) -> impl Iterator<Item = &'a Series<Owner, State>> {
+        self.series.iter().filter(move |s| (s.shown)(owner))
+    }
+}
+
+/// One series of a plot: its label, whether an owner has it, and its value after a step.
+pub struct Series<Owner, State> {
     /// Its label in the viewer.
     pub label: &'static str,
-    /// The title of the time-series view it is shown in.
-    pub view: &'static str,
     /// Whether an owner (from its settings) has this series.
     pub shown: fn(&Owner) -> bool,
     /// Its value after a step.
@@ -136,115 +174,140 @@ fn flag(on: bool) -> f64 {
     if on { 1.0 } else { 0.0 }
 }
 
-/// Every agent's time series, in the order of the views.
-pub const AGENT_SERIES: &[Series<Agent, AgentState>] = &[
-    Series {
+/// Every agent's plots, in the order of the views.
+pub const AGENT_PLOTS: &[Plot<Agent, AgentState>] = &[
+    Plot {
         key: "distance",
-        label: "distance to target (m)",
+        piecewise_constant: false,
         view: "distance to target (m)",
-        shown: always,
-        value: |_, s| s.distance,
+        series: &[Series {
+            label: "distance to target (m)",
+            shown: always,
+            value: |_, s| s.distance,
+        }],
     },
-    Series {
+    Plot {
         key: "speed",
-        label: "speed (m/s)",
+        piecewise_constant: false,
         view: "speed (m/s)",
-        shown: always,
-        value: |_, s| s.velocity.norm(),
+        series: &[
+            Series {
+                label: "speed (m/s)",
+                shown: always,
+                value: |_, s| s.velocity.norm(),
+            },
+            Series {
+                label: "speed along the guidance (m/s)",
+                shown: always,
+                value: |_, s| s.radial_speed,
+            },
+        ],
     },
-    Series {
-        key: "radial_speed",
-        label: "speed along the guidance (m/s)",
-        view: "speed (m/s)",
-        shown: always,
-        value: |_, s| s.radial_speed,
-    },
-    Series {
+    Plot {
         key: "force",
-        label: "|F| (N)",
+        piecewise_constant: false,
         view: "control force (N)",
-        shown: always,
-        value: |_, s| s.force.norm(),
+        series: &[
+            Series {
+                label: "|F| (N)",
+                shown: always,
+                value: |_, s| s.force.norm(),
+            },
+            Series {
+                label: "Fx (N)",
+                shown: always,
+                value: |_, s| s.force.x,
+            },
+            Series {
+                label: "Fy (N)",
+                shown: always,
+                value: |_, s| s.force.y,
+            },
+        ],
     },
-    Series {
-        key: "force_x",
-        label: "Fx (N)",
-        view: "control force (N)",
-        shown: always,
-        value: |_, s| s.force.x,
-    },
-    Series {
-        key: "force_y",
-        label: "Fy (N)",
-        view: "control force (N)",
-        shown: always,
-        value: |_, s| s.force.y,
-    },
-    Series {
+    Plot {
         key: "potential",
-        label: "V",
+        piecewise_constant: false,
         view: "potential V",
-        shown: always,
-        value: |_, s| s.potential,
+        series: &[Series {
+            label: "V",
+            shown: always,
+            value: |_, s| s.potential,
+        }],
     },
-    Series {
-        key: "clamping",
-        label: "clamping active",
+    Plot {
+        key: "limits",
+        piecewise_constant: true,
         view: "limits active (0/1)",
-        shown: |a| a.controller.clamp.is_some(),
-        value: |_, s| flag(s.clamping),
+        series: &[
+            Series {
+                label: "clamping active",
+                shown: |a| a.controller.clamp.is_some(),
+                value: |_, s| flag(s.clamping),
+            },
+            Series {
+                label: "speed limit active",
+                shown: |a| a.controller.speed_limit.is_some() || a.controller.brake.is_some(),
+                value: |_, s| flag(s.speed_limited),
+            },
+        ],
     },
-    Series {
-        key: "speed_limited",
-        label: "speed limit active",
-        view: "limits active (0/1)",
-        shown: |a| a.controller.speed_limit.is_some() || a.controller.brake.is_some(),
-        value: |_, s| flag(s.speed_limited),
-    },
-    Series {
-        key: "beta_x",
-        label: "β x (N)",
+    Plot {
+        key: "bias",
+        piecewise_constant: true,
         view: "bias β (N)",
-        shown: |a| a.controller.bias.is_some(),
-        value: |_, s| s.beta.map_or(0.0, |b| b.x),
-    },
-    Series {
-        key: "beta_y",
-        label: "β y (N)",
-        view: "bias β (N)",
-        shown: |a| a.controller.bias.is_some(),
-        value: |_, s| s.beta.map_or(0.0, |b| b.y),
+        series: &[
+            Series {
+                label: "β x (N)",
+                shown: |a| a.controller.bias.is_some(),
+                value: |_, s| s.beta.map_or(0.0, |b| b.x),
+            },
+            Series {
+                label: "β y (N)",
+                shown: |a| a.controller.bias.is_some(),
+                value: |_, s| s.beta.map_or(0.0, |b| b.y),
+            },
+        ],
     },
 ];
 
-/// Every pendulum's time series, in the order of the views.
-pub const PENDULUM_SERIES: &[Series<Pendulum, PendulumState>] = &[
-    Series {
+/// Every pendulum's plots, in the order of the views.
+pub const PENDULUM_PLOTS: &[Plot<Pendulum, PendulumState>] = &[
+    Plot {
         key: "theta",
-        label: "θ (rad)",
+        piecewise_constant: false,
         view: "pendulum angle θ (rad)",
-        shown: always,
-        value: |_, s| s.theta,
+        series: &[
+            Series {
+                label: "θ (rad)",
+                shown: always,
+                value: |_, s| s.theta,
+            },
+            Series {
+                label: "θ_T (rad)",
+                shown: always,
+                value: |p, _| p.target,
+            },
+        ],
     },
-    Series {
-        key: "target",
-        label: "θ_T (rad)",
-        view: "pendulum angle θ (rad)",
-        shown: always,
-        value: |p, _| p.target,
-    },
-    Series {
+    Plot {
         key: "torque",
-        label: "u (N·m)",
+        piecewise_constant: false,
         view: "torque u (N·m)",
-        shown: always,
-        value: |_, s| s.torque,
+        series: &[Series {
+            label: "u (N·m)",
+            shown: always,
+            value: |_, s| s.torque,
+        }],
     },
-    Series {
-        key: "beta",
-        label: "β (N·m)",
+    Plot {
+        key: "bias",
+        piecewise_constant: true,
         view: "bias β (N·m)",
-        shown: always,
-        value: |_, s| s.beta,
+        series: &[Series {
+            label: "β (N·m)",
+            shown: always,
+            value: |_, s| s.beta,
+        }],
     },
 ];

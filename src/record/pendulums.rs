@@ -3,7 +3,7 @@
 
 use rerun::RecordingStream;
 
-use super::names::{PENDULUM_SERIES, PendulumPaths, plot};
+use super::names::{PENDULUM_PLOTS, PendulumPaths, SIM_TIME, plot};
 use super::palette;
 use super::world::f32x2;
 use crate::sim::pendulum::PendulumRun;
@@ -32,21 +32,26 @@ pub fn log_setup(
             .with_colors([palette::rerun(palette::TARGET)])
             .with_radii([0.01]),
         )?;
-        for series in PENDULUM_SERIES.iter().filter(|s| (s.shown)(pendulum)) {
+        for p in PENDULUM_PLOTS {
             rec.log_static(
-                plot(&pendulum.name, series.key),
-                &rerun::SeriesLines::new().with_names([series.label]),
+                plot(&pendulum.name, p.key),
+                &p.lines(p.series_of(pendulum).map(|s| s.label)),
             )?;
         }
     }
     Ok(())
 }
 
-/// Logs each pendulum's rod, bob, bias update and series after a step.
+/// Logs each pendulum's rod, bob, bias update and series after the step that ended at
+/// `time`, s.
 pub fn log_step(
     rec: &RecordingStream,
+    time: f64,
     pendulums: &[PendulumRun],
 ) -> Result<(), rerun::RecordingStreamError> {
+    if !pendulums.is_empty() {
+        rec.set_duration_secs(SIM_TIME, time);
+    }
     for p in pendulums {
         let (pendulum, paths, s) = (&p.pendulum, PendulumPaths::of(&p.pendulum.name), &p.state);
         rec.log(
@@ -61,10 +66,10 @@ pub fn log_step(
                 .with_radii([0.08])
                 .with_colors([palette::rerun(palette::BODY)]),
         )?;
-        for series in PENDULUM_SERIES.iter().filter(|x| (x.shown)(pendulum)) {
+        for p in PENDULUM_PLOTS {
             rec.log(
-                plot(&pendulum.name, series.key),
-                &rerun::Scalars::single((series.value)(pendulum, s)),
+                plot(&pendulum.name, p.key),
+                &rerun::Scalars::new(p.series_of(pendulum).map(|x| (x.value)(pendulum, s))),
             )?;
         }
         if let Some(note) = &s.note {
