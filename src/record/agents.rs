@@ -117,6 +117,7 @@ impl Steps {
                 .map(|run| AgentPaths::of(&run.agent.name))
                 .collect();
         }
+        let mut sent = false;
         for (index, (run, state)) in agents.iter().zip(states).enumerate() {
             let paths = &self.paths[index];
             log_events(rec, sim.time(), paths, state)?;
@@ -132,7 +133,12 @@ impl Steps {
             columns.push(sim.time(), run, state);
             if columns.full() || last {
                 columns.send(rec, last)?;
+                sent = true;
             }
+        }
+        if sent {
+            // On to the file's writer now, to be encoded while the run goes on.
+            let _ = rec.flush_async();
         }
         Ok(())
     }

@@ -1,7 +1,5 @@
 //! The potential as a picture: `log10(1 - V)` through a perceptual colour map.
 
-use rayon::prelude::*;
-
 use super::palette::{BLOCKED, UNREACHABLE};
 use crate::field::HarmonicField;
 
@@ -11,10 +9,8 @@ pub fn potential_image(field: &HarmonicField) -> (Vec<u8>, [u32; 2]) {
     let grid = *field.grid();
     let w = field.sampler.values();
     let reachable = field.sampler.reachable_cells();
-    // log10(1 − V) once per cell (NaN where nothing is drawn from it), on every core: at
-    // 40 000 cells and more, the logarithms are most of what a recording costs to set up.
+    // log10(1 − V) once per cell (NaN where nothing is drawn from it).
     let logs: Vec<f64> = (0..grid.len())
-        .into_par_iter()
         .map(|k| {
             if field.blocked[k] || !reachable[k] {
                 f64::NAN
@@ -28,21 +24,18 @@ pub fn potential_image(field: &HarmonicField) -> (Vec<u8>, [u32; 2]) {
         .copied()
         .filter(|l| l.is_finite())
         .fold(0.0_f64, f64::min);
-    let mut rgb = vec![0; grid.len() * 3];
-    rgb.par_chunks_mut(3)
-        .zip(logs.par_iter())
-        .enumerate()
-        .for_each(|(k, (pixel, &l))| {
-            let colour = if field.blocked[k] {
-                BLOCKED
-            } else if !l.is_finite() {
-                UNREACHABLE
-            } else {
-                let t = if lo < 0.0 { 1.0 - l / lo } else { 1.0 };
-                viridis(t)
-            };
-            pixel.copy_from_slice(&colour);
-        });
+    let mut rgb = Vec::with_capacity(grid.len() * 3);
+    for (k, &l) in logs.iter().enumerate() {
+        let colour = if field.blocked[k] {
+            BLOCKED
+        } else if !l.is_finite() {
+            UNREACHABLE
+        } else {
+            let t = if lo < 0.0 { 1.0 - l / lo } else { 1.0 };
+            viridis(t)
+        };
+        rgb.extend_from_slice(&colour);
+    }
     (rgb, [grid.nx as u32, grid.ny as u32])
 }
 

@@ -217,10 +217,14 @@ impl Recorder {
         world::log_setup(&self.stream, &sim.world)?;
         pendulums::log_setup(&self.stream, &sim.pendulums)?;
         agents::log_setup(&self.stream, sim)?;
-        match self.layout.take() {
-            Some(layout) => blueprint::send(&self.stream, layout),
-            None => Ok(()),
+        if let Some(layout) = self.layout.take() {
+            blueprint::send(&self.stream, layout)?;
         }
+        // On to the file now, not at the batcher's next tick (200 ms for a file, longer than
+        // many runs): the file's writer encodes the set-up while the run goes, rather than all
+        // of it once the run has ended.
+        let _ = self.stream.flush_async();
+        Ok(())
     }
 
     /// Logs the state of every body after a step, at the simulation's time. (What is logged
