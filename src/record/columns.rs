@@ -293,81 +293,68 @@ impl AgentColumns {
             self.contacts.end();
             self.plots.iter_mut().for_each(|p| p.rows.end());
         }
-        let sim_time = |times: &[f64]| {
-            [TimeColumn::new_duration_secs(
-                SIM_TIME,
-                times.iter().copied(),
-            )]
-        };
         let times = std::mem::take(&mut self.times);
-        if !times.is_empty() {
-            rec.send_columns(
-                self.paths.body.as_str(),
-                sim_time(&times),
-                rerun::Transform3D::update_fields()
-                    .with_many_translation(std::mem::take(&mut self.translations))
-                    .columns_of_unit_batches()?,
-            )?;
-            for (path, vectors) in [
-                (&self.paths.velocity, std::mem::take(&mut self.velocities)),
-                (&self.paths.force, std::mem::take(&mut self.forces)),
-            ] {
-                rec.send_columns(
-                    path.as_str(),
-                    sim_time(&times),
-                    rerun::Arrows2D::update_fields()
-                        .with_vectors(vectors)
-                        .columns_of_unit_batches()?,
-                )?;
-            }
+        send(
+            rec,
+            &self.paths.body,
+            &times,
+            rerun::Transform3D::update_fields()
+                .with_many_translation(std::mem::take(&mut self.translations))
+                .columns_of_unit_batches()?,
+        )?;
+        for (path, vectors) in [
+            (&self.paths.velocity, std::mem::take(&mut self.velocities)),
+            (&self.paths.force, std::mem::take(&mut self.forces)),
+        ] {
+            let arrows = rerun::Arrows2D::update_fields().with_vectors(vectors);
+            send(rec, path, &times, arrows.columns_of_unit_batches()?)?;
         }
         let (times, colours) = self.colours.take();
-        if !times.is_empty() {
-            rec.send_columns(
-                self.paths.body.as_str(),
-                sim_time(&times),
-                rerun::Points2D::update_fields()
-                    .with_colors(colours)
-                    .columns_of_unit_batches()?,
-            )?;
-        }
+        let colours = rerun::Points2D::update_fields().with_colors(colours);
+        send(
+            rec,
+            &self.paths.body,
+            &times,
+            colours.columns_of_unit_batches()?,
+        )?;
         let (times, contacts) = self.contacts.take();
-        if !times.is_empty() {
-            let counts: Vec<usize> = contacts.iter().map(Vec::len).collect();
-            rec.send_columns(
-                self.paths.contacts.as_str(),
-                sim_time(&times),
-                rerun::Points2D::update_fields()
-                    .with_positions(contacts.into_iter().flatten())
-                    .columns(counts)?,
-            )?;
-        }
+        let counts: Vec<usize> = contacts.iter().map(Vec::len).collect();
+        let contacts =
+            rerun::Points2D::update_fields().with_positions(contacts.into_iter().flatten());
+        send(rec, &self.paths.contacts, &times, contacts.columns(counts)?)?;
         for p in &mut self.plots {
             let (times, rows) = p.rows.take();
-            if times.is_empty() {
-                continue;
-            }
             let n = p.values.len();
-            rec.send_columns(
-                plot(&self.name, p.key),
-                sim_time(&times),
-                rerun::Scalars::new(rows.iter().flat_map(|r| r[..n].iter().copied()))
-                    .columns(std::iter::repeat_n(n, rows.len()))?,
-            )?;
+            let scalars = rerun::Scalars::new(rows.iter().flat_map(|r| r[..n].iter().copied()));
+            let columns = scalars.columns(std::iter::repeat_n(n, rows.len()))?;
+            send(rec, &plot(&self.name, p.key), &times, columns)?;
         }
         let (times, segments): (Vec<f64>, Vec<_>) =
             std::mem::take(&mut self.trail).into_iter().unzip();
-        if !times.is_empty() {
-            rec.send_columns(
-                self.paths.trail.as_str(),
-                sim_time(&times),
-                rerun::LineStrips2D::update_fields()
-                    .with_strips(segments)
-                    .columns_of_unit_batches()?,
-            )?;
-        }
+        let trail = rerun::LineStrips2D::update_fields().with_strips(segments);
+        send(
+            rec,
+            &self.paths.trail,
+            &times,
+            trail.columns_of_unit_batches()?,
+        )?;
         Ok(())
     }
+}
+
+/// Sends `columns` of `entity`, one row per time of `times` (s on `sim_time`), unless there
+/// are none.
+fn send(
+    rec: &RecordingStream,
+    entity: &str,
+    times: &[f64],
+    columns: impl IntoIterator<Item = rerun::SerializedComponentColumn>,
+) -> Result<(), rerun::RecordingStreamError> {
+    if times.is_empty() {
+        return Ok(());
+    }
+    let times = TimeColumn::new_duration_secs(SIM_TIME, times.iter().copied());
+    rec.send_columns(entity, [times], columns)
 }
 
 #[cfg(test)]
