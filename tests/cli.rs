@@ -570,6 +570,38 @@ fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
     }
 }
 
+/// Seven simulated minutes of a 192 m world (the arena at 4 m a cell, `worlds/map-arena-200.toml`)
+/// record every step in under 10 MB, with a view that follows the robot.
+#[test]
+fn a_seven_minute_run_of_a_192_m_world_records_every_step_in_under_10_mb() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("map-arena-200.toml");
+    let out = nadf(dir.path(), &["run", world.to_str().unwrap(), "-o", "a.rrd"]);
+    common::assert_success(&out);
+    let rrd = dir.path().join("a.rrd");
+    let size = std::fs::metadata(&rrd).unwrap().len();
+    assert!(size < 10_000_000, "{size} bytes");
+    let recording = Recording::read(&rrd);
+    for (e, component) in [
+        ("agents/robot/body", "Transform3D:translation"),
+        ("agents/robot/body/force", "Arrows2D:vectors"),
+    ] {
+        assert_eq!(recording.rows(e, component), 42_000, "{e}");
+    }
+    assert_eq!(
+        recording
+            .values::<2>("agents/robot/trail", "LineStrips2D:strips")
+            .len(),
+        42_000 / 25
+    );
+    assert!(
+        recording
+            .layout
+            .iter()
+            .any(|e| e.ends_with("/VisualBounds2D"))
+    );
+}
+
 /// An output that cannot be written is bad input (exit 2), found before anything is solved or
 /// simulated: nothing is printed on standard output and nothing is left behind.
 #[test]
@@ -676,14 +708,20 @@ fn connect_streams_the_run_to_a_running_viewer() {
         has_run(&received),
         "the viewer did not receive all 800 steps"
     );
-    let (entities, _) = decode(&received);
+    let recording = Recording::read(&received);
     for e in [
         "world/walls",
         "agents/robot/field/potential",
         "plots/robot/distance",
     ] {
-        assert!(entities.contains(e), "no `{e}` in {entities:?}");
+        assert!(
+            recording.rows.contains_key(e),
+            "no `{e}` in {:?}",
+            recording.rows.keys()
+        );
     }
+    // The layout came too.
+    assert!(recording.layout.iter().any(|e| e.ends_with("/TimeAxis")));
     assert!(has_run(&dir.path().join("also.rrd")));
 }
 
