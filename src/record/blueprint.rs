@@ -119,11 +119,16 @@ fn messages(
     let (capture, storage) = RecordingStreamBuilder::new("nadf").memory()?;
     blueprint.send(&capture, BlueprintActivation::default())?;
     let mut messages = storage.take();
-    let Some(LogMsg::BlueprintActivationCommand(activate)) = messages.pop() else {
-        unreachable!("a blueprint ends with the command that activates it");
-    };
+    let activate = messages
+        .iter()
+        .find_map(|m| match m {
+            LogMsg::BlueprintActivationCommand(c) => Some(c.clone()),
+            _ => None,
+        })
+        .expect("a blueprint is sent with the command that activates it");
     let store = activate.blueprint_id.clone();
-    messages.retain(|m| m.store_id() == &store);
+    messages
+        .retain(|m| m.store_id() == &store && !matches!(m, LogMsg::BlueprintActivationCommand(_)));
     // The properties, into the same store, on the builder's `blueprint` timeline (as chunks
     // made here: a stream of their own would cost another thread and flush).
     let when = rerun::TimePoint::default().with(rerun::Timeline::new_sequence("blueprint"), 0);
