@@ -87,17 +87,29 @@ pub fn log_setup(
     Ok(())
 }
 
-/// What the agents log every step: their columns (made at the first step), and which lidar
-/// field each last logged.
+/// What the agents log every step: their columns, and which lidar field each last logged
+/// (empty until the recording is set up).
 #[derive(Default)]
 pub struct Steps {
     columns: Vec<AgentColumns>,
-    paths: Vec<AgentPaths>,
     /// Per agent, the lidar field last logged (`LidarRun::fields`).
     fields_logged: Vec<usize>,
 }
 
 impl Steps {
+    /// Every agent's empty columns, their static parts logged.
+    pub fn new(
+        rec: &RecordingStream,
+        sim: &Simulation,
+    ) -> Result<Self, rerun::RecordingStreamError> {
+        Ok(Self {
+            columns: (sim.agents.iter())
+                .map(|run| AgentColumns::new(rec, run))
+                .collect::<Result<_, _>>()?,
+            fields_logged: vec![0; sim.agents.len()],
+        })
+    }
+
     /// Logs each agent's state after a step; `last` is the run's last step (the columns are
     /// then sent whatever they hold).
     pub fn log_step(
@@ -107,29 +119,20 @@ impl Steps {
         states: &[AgentState],
         last: bool,
     ) -> Result<(), rerun::RecordingStreamError> {
-        let agents = &sim.agents;
-        self.fields_logged.resize(agents.len(), 0);
-        if self.columns.is_empty() {
-            self.columns = (agents.iter())
-                .map(|run| AgentColumns::new(rec, run))
-                .collect::<Result<_, _>>()?;
-            self.paths = (agents.iter())
-                .map(|run| AgentPaths::of(&run.agent.name))
-                .collect();
-        }
         let mut sent = false;
-        for (index, (run, state)) in agents.iter().zip(states).enumerate() {
-            let paths = &self.paths[index];
-            log_events(rec, sim.time(), paths, state)?;
+        let agents = sim.agents.iter().zip(states);
+        for ((run, state), (columns, field_logged)) in
+            agents.zip(self.columns.iter_mut().zip(&mut self.fields_logged))
+        {
+            log_events(rec, sim.time(), columns.paths(), state)?;
             if let Some(lidar) = &run.lidar {
                 let due = lidar.lidar.scans % LIDAR_IMAGE_EVERY == 1;
-                let new = self.fields_logged[index] != lidar.fields;
+                let new = *field_logged != lidar.fields;
                 if state.scan.is_some() && due && new {
-                    self.fields_logged[index] = lidar.fields;
+                    *field_logged = lidar.fields;
                 }
-                log_lidar(rec, paths, sim, run, state, due && new)?;
+                log_lidar(rec, columns.paths(), sim, run, state, due && new)?;
             }
-            let columns = &mut self.columns[index];
             columns.push(sim.time(), run, state);
             if columns.full() || last {
                 columns.send(rec, last)?;

@@ -192,10 +192,7 @@ impl AgentColumns {
             if series.is_empty() {
                 continue;
             }
-            rec.log_static(
-                plot(&run.agent.name, p.key),
-                &p.lines(series.iter().map(|s| s.label)),
-            )?;
+            rec.log_static(plot(&run.agent.name, p.key), &p.lines(&run.agent))?;
             plots.push(PlotColumn {
                 key: p.key,
                 values: series.iter().map(|s| s.value).collect(),
@@ -217,6 +214,11 @@ impl AgentColumns {
             segment_time: 0.0,
             trail: Vec::new(),
         })
+    }
+
+    /// The agent's entities.
+    pub fn paths(&self) -> &AgentPaths {
+        &self.paths
     }
 
     /// Keeps `run`'s state after the step that ended at `time`, s.

@@ -160,7 +160,7 @@ impl Recorder {
         };
         let stream = match (viewer, &file) {
             (None, Some((partial, _))) => builder.save(partial).map_err(stream_error(partial))?,
-            (None, None) => return Ok(Self::disabled()),
+            (None, None) => RecordingStream::disabled(),
             (Some(viewer), file) => {
                 let url = match viewer {
                     Viewer::Spawn => {
@@ -201,22 +201,12 @@ impl Recorder {
         })
     }
 
-    /// A recorder that records nothing.
-    fn disabled() -> Self {
-        Self {
-            stream: RecordingStream::disabled(),
-            layout: None,
-            file: None,
-            steps: agents::Steps::default(),
-            last_flush: std::time::Instant::now(),
-        }
-    }
-
     /// Logs everything that does not change during the run: geometry, fields, kinematic paths.
     pub fn log_setup(&mut self, sim: &Simulation) -> Result<(), rerun::RecordingStreamError> {
         world::log_setup(&self.stream, &sim.world)?;
         pendulums::log_setup(&self.stream, &sim.pendulums)?;
         agents::log_setup(&self.stream, sim)?;
+        self.steps = agents::Steps::new(&self.stream, sim)?;
         if let Some(layout) = self.layout.take() {
             blueprint::send(&self.stream, layout)?;
         }

@@ -137,9 +137,9 @@ pub struct Plot<Owner: 'static, State: 'static> {
 }
 
 impl<Owner, State> Plot<Owner, State> {
-    /// How the plot's series with `labels` are drawn.
-    pub fn lines<'a>(&self, labels: impl IntoIterator<Item = &'a str>) -> rerun::SeriesLines {
-        let lines = rerun::SeriesLines::new().with_names(labels);
+    /// How the plot of `owner` is drawn: its series' labels, and the aggregation.
+    pub fn lines(&self, owner: &Owner) -> rerun::SeriesLines {
+        let lines = rerun::SeriesLines::new().with_names(self.series_of(owner).map(|s| s.label));
         if self.piecewise_constant {
             lines.with_aggregation_policy(rerun::components::AggregationPolicy::Off)
         } else {

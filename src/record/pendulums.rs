@@ -33,10 +33,7 @@ pub fn log_setup(
             .with_radii([0.01]),
         )?;
         for p in PENDULUM_PLOTS {
-            rec.log_static(
-                plot(&pendulum.name, p.key),
-                &p.lines(p.series_of(pendulum).map(|s| s.label)),
-            )?;
+            rec.log_static(plot(&pendulum.name, p.key), &p.lines(pendulum))?;
         }
     }
     Ok(())
