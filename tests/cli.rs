@@ -33,12 +33,6 @@ fn fixture(name: &str) -> std::path::PathBuf {
         .join(name)
 }
 
-/// Every entity path and timeline in a recording, read back with Rerun's own decoder.
-fn decode(path: &Path) -> (BTreeSet<String>, BTreeSet<String>) {
-    let recording = Recording::read(path);
-    (recording.rows.into_keys().collect(), recording.timelines)
-}
-
 /// A recording read back with Rerun's own decoder.
 struct Recording {
     /// Per entity, per component (`Archetype:field`), its rows on the `sim_time` timeline (0
@@ -93,6 +87,23 @@ impl Recording {
             .and_then(|c| c.get(component))
             .copied()
             .unwrap_or(0)
+    }
+
+    /// Whether the recording has `what`: an entity, or `ENTITY[LABEL]`, a series of that plot.
+    fn has(&self, what: &str) -> bool {
+        match what.split_once('[') {
+            Some((entity, label)) => self
+                .labels(entity)
+                .contains(&label.trim_end_matches(']').to_string()),
+            None => self.rows.contains_key(what),
+        }
+    }
+
+    /// Asserts that the recording has each of `entities` (see [`Self::has`]).
+    fn assert_has(&self, entities: &[&str]) {
+        for e in entities {
+            assert!(self.has(e), "no `{e}` in {:?}", self.rows.keys());
+        }
     }
 
     /// The labels of the series of the plot `entity`.
@@ -173,7 +184,7 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
     );
 
     let recording = Recording::read(&rrd);
-    for e in [
+    recording.assert_has(&[
         "world/box",
         "world/walls",
         "agents/robot/field/potential",
@@ -189,13 +200,7 @@ fn run_writes_a_recording_that_decodes_with_every_entity_and_a_json_summary() {
         "plots/robot/speed",
         "plots/robot/force",
         "plots/robot/potential",
-    ] {
-        assert!(
-            recording.rows.contains_key(e),
-            "no `{e}` in {:?}",
-            recording.rows.keys()
-        );
-    }
+    ]);
     assert!(recording.timelines.contains("sim_time"));
     // Every step of the 8 s is there: where the body is and its arrows.
     for (e, component) in [
@@ -282,7 +287,7 @@ fn no_record_writes_nothing_and_the_default_recording_is_named_after_the_world()
     common::assert_success(&out);
     let rrd = dir.path().join("room-two-dividers.rrd");
     assert!(rrd.is_file());
-    assert!(decode(&rrd).0.contains("agents/robot/body"));
+    assert!(Recording::read(&rrd).has("agents/robot/body"));
 }
 
 #[test]
@@ -531,17 +536,15 @@ fn recordings_show_clamping_bias_speed_limit_and_sensed_walls() {
         );
         common::assert_success(&out);
         let recording = Recording::read(&dir.path().join("r.rrd"));
-        let has = |e: &str| match e.split_once('[') {
-            Some((entity, label)) => recording
-                .labels(entity)
-                .contains(&label.trim_end_matches(']').to_string()),
-            None => recording.rows.contains_key(e),
-        };
         for e in present {
-            assert!(has(e), "{world}: no `{e}` in {:?}", recording.rows.keys());
+            assert!(
+                recording.has(e),
+                "{world}: no `{e}` in {:?}",
+                recording.rows.keys()
+            );
         }
         for e in absent {
-            assert!(!has(e), "{world}: unexpected `{e}`");
+            assert!(!recording.has(e), "{world}: unexpected `{e}`");
         }
         // The layout: every plot view shows the whole run (its time axis is set), every
         // agent's trail shows up to the cursor, and a world far longer than wide (the corridor)
@@ -709,17 +712,11 @@ fn connect_streams_the_run_to_a_running_viewer() {
         "the viewer did not receive all 800 steps"
     );
     let recording = Recording::read(&received);
-    for e in [
+    recording.assert_has(&[
         "world/walls",
         "agents/robot/field/potential",
         "plots/robot/distance",
-    ] {
-        assert!(
-            recording.rows.contains_key(e),
-            "no `{e}` in {:?}",
-            recording.rows.keys()
-        );
-    }
+    ]);
     // The layout came too.
     assert!(recording.layout.iter().any(|e| e.ends_with("/TimeAxis")));
     assert!(has_run(&dir.path().join("also.rrd")));
