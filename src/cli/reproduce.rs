@@ -50,7 +50,7 @@ pub fn reproduce(args: &ReproduceArgs, console: &Console) -> Result<(), Failure>
     };
     let wall_time = started.elapsed();
     let checked = reproduce::check(&claims, &outcomes);
-    let report = report::build(&claims, &checked, experiments.len(), wall_time);
+    let report = report::build(&claims, &checked, &outcomes, experiments.len(), wall_time);
     let mut files = Vec::new();
     for f in &figures {
         let png = figure::draw(f, &outcomes)
@@ -65,11 +65,9 @@ pub fn reproduce(args: &ReproduceArgs, console: &Console) -> Result<(), Failure>
         .map_err(|e| bad(&format!("cannot create {}: {e}", dir.display())))?;
     write_all(dir, files)?;
     println!(
-        "{} claims: {} reproduced, {} weaker, {} differ; {} runs in {:.1} s",
+        "{} claims. {} {} runs in {:.1} s",
         checked.len(),
-        report.reproduced,
-        report.weaker,
-        report.differs,
+        report::counts_line(&report),
         experiments.len(),
         wall_time.as_secs_f64()
     );

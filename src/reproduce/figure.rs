@@ -1,6 +1,7 @@
 //! The reproduction's figures, in the paper's style: the paths over the world's walls for the
-//! trajectory figures, the time series the paper plots for the others. Drawn with plotters
-//! and the bundled font, like the sweep's plot.
+//! trajectory figures (to scale: one metre is as long on both axes), the time series the paper
+//! plots for the others, and the calibration's curves over the gain. Drawn with plotters and
+//! the bundled font, like the sweep's plot.
 
 use plotters::prelude::*;
 
@@ -10,59 +11,80 @@ use crate::world::wall_outline;
 
 /// Picture size, pixels.
 const SIZE: (u32, u32) = (1000, 700);
+/// The chart's margin and the heights of its label areas, pixels.
+const MARGIN: f64 = 16.0;
+const X_LABELS: f64 = 45.0;
+const Y_LABELS: f64 = 70.0;
 
 /// What a figure plots, for the experiments it names.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Panel {
     /// The paths of every agent over the walls, to scale.
-    Paths(&'static [&'static str]),
-    /// The lateral position against the distance along a corridor (not to scale).
-    Lateral(&'static [&'static str]),
+    Paths(Vec<String>),
+    /// The lateral position against the distance along a corridor (the lateral axis stretched).
+    Lateral(Vec<String>),
     /// The distance to the target against time.
-    Distance(&'static [&'static str]),
+    Distance(Vec<String>),
     /// The speed against time.
-    Speed(&'static [&'static str]),
+    Speed(Vec<String>),
+    /// The radial speed (along the guidance) against time.
+    Radial(Vec<String>),
     /// The control force's magnitude against time.
-    Force(&'static [&'static str]),
+    Force(Vec<String>),
     /// A pendulum's error `θ_T − θ` against time.
-    Angle(&'static [&'static str]),
+    Angle(Vec<String>),
     /// The settling time against the damping coefficient, one point per run (never settled:
     /// the run's duration).
-    Settling(&'static [&'static str]),
+    Settling(Vec<String>),
+    /// The calibration: the settling times of NADF and viscous damping and their ratio against
+    /// the gain K (log scales), the calibrated K and the paper's ratio marked.
+    OverGain {
+        /// `(K, NADF run, viscous run)`, in increasing K.
+        pairs: Vec<(f64, String, String)>,
+        /// The calibrated gain.
+        calibrated: f64,
+        /// The paper's ratio.
+        paper_ratio: f64,
+    },
 }
 
 /// One figure.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Figure {
     /// Its id: the file is `ID.png`.
-    pub id: &'static str,
+    pub id: String,
     /// Its title.
-    pub title: &'static str,
+    pub title: String,
     /// What it plots.
     pub panel: Panel,
 }
 
 impl Figure {
     /// The experiments it plots.
-    pub fn runs(&self) -> &'static [&'static str] {
-        match self.panel {
+    pub fn runs(&self) -> Vec<String> {
+        match &self.panel {
             Panel::Paths(r)
             | Panel::Lateral(r)
             | Panel::Distance(r)
             | Panel::Speed(r)
+            | Panel::Radial(r)
             | Panel::Force(r)
             | Panel::Angle(r)
-            | Panel::Settling(r) => r,
+            | Panel::Settling(r) => r.clone(),
+            Panel::OverGain { pairs, .. } => pairs
+                .iter()
+                .flat_map(|(_, a, b)| [a.clone(), b.clone()])
+                .collect(),
         }
     }
 }
 
 /// The legend of experiment `id`.
-fn label(id: &str) -> &'static str {
+fn label(id: &str) -> String {
     experiments()
         .into_iter()
         .find(|e| e.id == id)
-        .map_or("?", |e| e.label)
+        .map_or("?".into(), |e| e.label)
 }
 
 /// Every `n`-th sample, so a line has at most about 2000 points.
@@ -76,7 +98,7 @@ type Line = (String, usize, Vec<(f64, f64)>);
 /// One line per run (and agent) of the figure's time series or paths.
 fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
     let mut out = Vec::new();
-    if let Panel::Settling(runs) = figure.panel {
+    if let Panel::Settling(runs) = &figure.panel {
         let points = runs
             .iter()
             .map(|id| {
@@ -87,6 +109,51 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
             .collect();
         return vec![("settling time".into(), 0, points)];
     }
+    if let Panel::OverGain {
+        pairs,
+        paper_ratio,
+        calibrated,
+    } = &figure.panel
+    {
+        let settle = |id: &str| super::settle(outcomes, id);
+        let nadf: Vec<(f64, f64)> = pairs.iter().map(|(k, a, _)| (*k, settle(a))).collect();
+        let viscous: Vec<(f64, f64)> = pairs.iter().map(|(k, _, b)| (*k, settle(b))).collect();
+        let ratio: Vec<(f64, f64)> = pairs
+            .iter()
+            .map(|(k, a, b)| (*k, settle(b) / settle(a)))
+            .collect();
+        let (k0, k1) = (pairs[0].0, pairs[pairs.len() - 1].0);
+        let log = |points: Vec<(f64, f64)>| -> Vec<(f64, f64)> {
+            points
+                .into_iter()
+                .map(|(x, y)| (x.log10(), y.log10()))
+                .collect()
+        };
+        let marked = |k: f64| vec![(k, 1.0), (k, 300.0)];
+        let lines: Vec<Line> = vec![
+            ("T_S, NADF B_d = 10 (s)".into(), 0, nadf),
+            ("T_S, viscous B = 0.7 (s)".into(), 1, viscous),
+            ("ratio viscous / NADF".into(), 2, ratio),
+            (
+                format!("the paper's ratio, {paper_ratio}"),
+                3,
+                vec![(k0, *paper_ratio), (k1, *paper_ratio)],
+            ),
+            (
+                "the paper's T_S, 12 s".into(),
+                4,
+                vec![
+                    (k0, super::calibration::T_FIGURE_16),
+                    (k1, super::calibration::T_FIGURE_16),
+                ],
+            ),
+            ("the calibrated K".into(), 5, marked(*calibrated)),
+        ];
+        return lines
+            .into_iter()
+            .map(|(name, colour, points)| (name, colour, log(points)))
+            .collect();
+    }
     for (colour, id) in figure.runs().iter().enumerate() {
         let o = &outcomes[id];
         let step = thin(o);
@@ -94,30 +161,45 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
         if let Panel::Angle(_) = figure.panel {
             let target = o.world.pendulums[0].target;
             let points = samples.map(|s| (s.time, target - s.pendulums[0])).collect();
-            out.push((label(id).to_string(), colour, points));
+            out.push((label(id), colour, points));
             continue;
         }
         for (a, agent) in o.world.agents.iter().enumerate() {
             let [tx, ty] = agent.target;
             let point = |s: &super::Sample| {
-                let [x, y, vx, vy, fx, fy] = s.agents[a];
+                let [x, y, vx, vy, fx, fy, radial, _] = s.agents[a];
                 match figure.panel {
                     Panel::Paths(_) | Panel::Lateral(_) => (x, y),
                     Panel::Distance(_) => (s.time, (x - tx).hypot(y - ty)),
                     Panel::Speed(_) => (s.time, vx.hypot(vy)),
+                    Panel::Radial(_) => (s.time, radial),
                     Panel::Force(_) => (s.time, fx.hypot(fy)),
-                    Panel::Angle(_) | Panel::Settling(_) => unreachable!("handled above"),
+                    Panel::Angle(_) | Panel::Settling(_) | Panel::OverGain { .. } => {
+                        unreachable!("handled above")
+                    }
                 }
             };
             let mut points: Vec<(f64, f64)> = vec![];
             if matches!(figure.panel, Panel::Paths(_) | Panel::Lateral(_)) {
+                // Paths are thinned by distance, not by step: a body at 40 m/s crosses metres
+                // in the steps a count would skip.
+                let ([lx, ly], [hx, hy]) = o.world.bounds();
+                let spacing = (hx - lx).hypot(hy - ly) / 2000.0;
                 points.push((agent.start[0], agent.start[1]));
+                for s in &o.trace {
+                    let p = point(s);
+                    let last = points[points.len() - 1];
+                    if (p.0 - last.0).hypot(p.1 - last.1) >= spacing {
+                        points.push(p);
+                    }
+                }
+            } else {
+                points.extend(samples.clone().map(point));
             }
-            points.extend(samples.clone().map(point));
             let name = if o.world.agents.len() > 1 {
                 format!("{} ({})", label(id), agent.name)
             } else {
-                label(id).to_string()
+                label(id)
             };
             out.push((name, colour, points));
         }
@@ -125,18 +207,24 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
     out
 }
 
+/// The range of width `span` about the middle of `[lo, hi]` (a plot drawn to scale).
+fn widen(lo: f64, hi: f64, span: f64) -> (f64, f64) {
+    let middle = 0.5 * (lo + hi);
+    (middle - 0.5 * span, middle + 0.5 * span)
+}
+
 /// Draws `figure` from `outcomes` (which must hold its runs) as PNG bytes.
 pub fn draw(figure: &Figure, outcomes: &Outcomes) -> Result<Vec<u8>, String> {
     register_font();
     let lines = lines(figure, outcomes);
-    let first = &outcomes[figure.runs()[0]];
+    let first = &outcomes[&figure.runs()[0]];
     let (w, h) = SIZE;
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let root = root
-            .titled(figure.title, ("sans-serif", 22))
+            .titled(&figure.title, ("sans-serif", 22))
             .map_err(|e| e.to_string())?;
         let e = |e: DrawingAreaErrorKind<_>| e.to_string();
         let (xs, ys): (Vec<f64>, Vec<f64>) = lines.iter().flat_map(|l| l.2.iter().copied()).unzip();
@@ -146,17 +234,35 @@ pub fn draw(figure: &Figure, outcomes: &Outcomes) -> Result<Vec<u8>, String> {
                 v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
             )
         };
+        // The plot's area, pixels: the drawing area less the margins and the label areas.
+        let (pw, ph) = root.dim_in_pixel();
+        let (plot_w, plot_h) = (
+            f64::from(pw) - 2.0 * MARGIN - Y_LABELS,
+            f64::from(ph) - 2.0 * MARGIN - X_LABELS,
+        );
         let ((x0, x1), (y0, y1), (x_desc, y_desc)) = match figure.panel {
-            Panel::Paths(_) | Panel::Lateral(_) => {
+            Panel::Paths(_) => {
+                // To scale: a metre is as many pixels on both axes.
                 let ([lx, ly], [hx, hy]) = first.world.bounds();
-                let x1 = if let Panel::Lateral(_) = figure.panel {
-                    // The corridor's part the runs cover, not its 110 m.
-                    xs.iter().copied().fold(lx, f64::max).min(hx) + 1.0
-                } else {
-                    hx
-                };
-                ((lx, x1), (ly, hy), ("x (m)", "y (m)"))
+                let scale = ((hx - lx) / plot_w).max((hy - ly) / plot_h);
+                (
+                    widen(lx, hx, scale * plot_w),
+                    widen(ly, hy, scale * plot_h),
+                    ("x (m)", "y (m)"),
+                )
             }
+            Panel::Lateral(_) => {
+                let ([lx, ly], [hx, hy]) = first.world.bounds();
+                // The corridor's part the runs cover, not its 110 m.
+                let x1 = xs.iter().copied().fold(lx, f64::max).min(hx) + 1.0;
+                ((lx, x1), (ly, hy), ("x (m)", "y (m), stretched"))
+            }
+            Panel::Radial(_) => (
+                (0.0, first.world.duration),
+                range(&ys),
+                ("t (s)", "radial speed −uᵀv (m/s)"),
+            ),
+            Panel::OverGain { .. } => (range(&xs), range(&ys), ("log₁₀ K", "log₁₀ (s, or ratio)")),
             Panel::Distance(_) => (
                 (0.0, first.world.duration),
                 range(&ys),
@@ -180,9 +286,9 @@ pub fn draw(figure: &Figure, outcomes: &Outcomes) -> Result<Vec<u8>, String> {
             Panel::Settling(_) => (range(&xs), range(&ys), ("B (N·s/m)", "settling time (s)")),
         };
         let mut chart = ChartBuilder::on(&root)
-            .margin(16)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
+            .margin(MARGIN as u32)
+            .x_label_area_size(X_LABELS as u32)
+            .y_label_area_size(Y_LABELS as u32)
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(e)?;
         chart
