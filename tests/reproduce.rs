@@ -2,7 +2,7 @@
 //! paper's where it is reproduced, the sandbox's measured one where not); the declared
 //! calibration is the one its sweeps give; the committed report, its JSON, every figure and
 //! the README's counts are this code's; and the command writes them. The whole reproduction
-//! runs here: it takes about 20 s.
+//! runs here: it takes about half a minute.
 
 mod common;
 

@@ -225,6 +225,14 @@ impl Claim {
         self
     }
 
+    /// Its reason also reads the runs of `curve`.
+    fn also(mut self, curve: &Curve) -> Self {
+        for (_, a, b) in curve {
+            self.runs.extend([a.clone(), b.clone()]);
+        }
+        self
+    }
+
     /// The paper's relation does not hold: the sandbox is held to `relation`, for `reason`.
     fn or(
         mut self,
@@ -507,6 +515,9 @@ fn n(x: f64) -> String {
 
 // --- The table ------------------------------------------------------------------------------
 
+/// The gains of the swap's curve under the paper's law (with the calibrated one), J.
+const SWAP_GAINS: [f64; 3] = [30.0, 100.0, 300.0];
+
 /// The damping coefficients of the room's sweeps (figures 23 and 24).
 const VISCOUS_B: [f64; 6] = [0.1, 0.15, 0.3, 0.7, 1.0, 3.0];
 const NADF_B: [f64; 5] = [1.0, 3.0, 10.0, 30.0, 100.0];
@@ -626,8 +637,10 @@ fn calibration_runs(t: &mut Table) {
             title,
             Panel::OverGain {
                 pairs,
+                names: ("NADF B_d = 10".into(), "viscous B = 0.7".into()),
                 calibrated: gain_of(law),
                 paper_ratio: 6.0,
+                paper_times: (calibration::T_FIGURE_16, 72.0),
             },
         );
     }
@@ -778,7 +791,8 @@ fn room(t: &mut Table, law: Law) {
         move |o| contacts(o, &r),
     ));
     let r = v07.clone();
-    let curve = law;
+    let curve = room_curve(law);
+    let curve2 = curve.clone();
     t.claim(
         Claim::new(
             &format!("{p}fig8-72s"),
@@ -792,13 +806,14 @@ fn room(t: &mut Table, law: Law) {
             move |o| settle(o, &r),
         )
         .value(72.0)
+        .also(&curve)
         .or(Verdict::Differs, Relation::AtLeast(0.0), move |o| {
             format!(
                 "with K calibrated to figure 16's 12 s the viscous body is faster than the paper's; \
                  the calibration curve gives 72 s only at K ≈ {}, where NADF takes {} s",
-                gain_at_time(o, curve, false, 72.0).map_or("(off the sweep)".into(), n),
-                gain_at_time(o, curve, false, 72.0)
-                    .map_or("?".into(), |k| n(time_at_gain(o, curve, true, k)))
+                gain_at_time(o, &curve, false, 72.0).map_or("(off the sweep)".into(), n),
+                gain_at_time(o, &curve, false, 72.0)
+                    .map_or("?".into(), |k| n(time_at_gain(o, &curve, true, k)))
             )
         }),
     );
@@ -840,7 +855,9 @@ fn room(t: &mut Table, law: Law) {
             move |o| slower_without_contact(o, &a, &b),
         )
         .value(6.0)
+        .also(&curve2)
         .or(Verdict::Weaker, Relation::AtLeast(1.5), move |o| {
+            let curve = &curve2;
             let k6 = gain_at_ratio(o, curve, 6.0);
             format!(
                 "the ratio depends on K (calibration curve: {}); 6× needs K ≈ {}, where NADF settles in {} s, not 12 s",
@@ -1013,51 +1030,54 @@ fn settling_over_b(o: &Outcomes, runs: &[String]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// The calibration curve of `law`: `(K, T_S NADF, T_S viscous)` over the sweep.
-fn gain_curve(o: &Outcomes, law: Law) -> Vec<(f64, f64, f64)> {
-    sweep(law)
-        .into_iter()
-        .map(|k| {
-            (
-                k,
-                settle(o, &gain_run(law, true, k)),
-                settle(o, &gain_run(law, false, k)),
-            )
-        })
+/// A curve over the gain: `(K, NADF run, viscous run)`, in increasing K.
+type Curve = Vec<(f64, String, String)>;
+
+/// The room's calibration curve under `law`.
+fn room_curve(law: Law) -> Curve {
+    (sweep(law).into_iter())
+        .map(|k| (k, gain_run(law, true, k), gain_run(law, false, k)))
+        .collect()
+}
+
+/// `(K, T_S NADF, T_S viscous)` over `curve`.
+fn gain_curve(o: &Outcomes, curve: &Curve) -> Vec<(f64, f64, f64)> {
+    (curve.iter())
+        .map(|(k, a, b)| (*k, settle(o, a), settle(o, b)))
         .collect()
 }
 
 /// The ratio over K as text: `K: ratio×, …`.
-fn ratio_curve(o: &Outcomes, law: Law) -> String {
-    (gain_curve(o, law).into_iter())
+fn ratio_curve(o: &Outcomes, curve: &Curve) -> String {
+    (gain_curve(o, curve).into_iter())
         .map(|(k, tn, tv)| format!("{}: {}×", n(k), n(tv / tn)))
         .collect::<Vec<_>>()
         .join(", ")
 }
 
 /// The gain at which the ratio reaches `ratio` (log-log interpolation on the curve).
-fn gain_at_ratio(o: &Outcomes, law: Law, ratio: f64) -> Option<f64> {
-    let points: Vec<(f64, f64)> = (gain_curve(o, law).into_iter())
+fn gain_at_ratio(o: &Outcomes, curve: &Curve, ratio: f64) -> Option<f64> {
+    let points: Vec<(f64, f64)> = (gain_curve(o, curve).into_iter())
         .map(|(k, tn, tv)| (k, tv / tn))
         .collect();
     calibration::gain_for(&points, ratio)
 }
 
-/// The gain at which NADF (or viscous B = 0.7) settles in `time` on the curve.
-fn gain_at_time(o: &Outcomes, law: Law, nadf: bool, time: f64) -> Option<f64> {
-    let points: Vec<(f64, f64)> = (gain_curve(o, law).into_iter())
+/// The settling times of NADF (or viscous) over `curve`.
+fn times(o: &Outcomes, curve: &Curve, nadf: bool) -> Vec<(f64, f64)> {
+    (gain_curve(o, curve).into_iter())
         .map(|(k, tn, tv)| (k, if nadf { tn } else { tv }))
-        .collect();
-    calibration::gain_for(&points, time)
+        .collect()
 }
 
-/// The settling time of NADF (or viscous B = 0.7) at gain `k`, interpolated on the curve.
-fn time_at_gain(o: &Outcomes, law: Law, nadf: bool, k: f64) -> f64 {
-    let points: Vec<(f64, f64)> = (gain_curve(o, law).into_iter())
-        .map(|(g, tn, tv)| (g, if nadf { tn } else { tv }))
-        .collect();
-    points
-        .windows(2)
+/// The gain at which NADF (or viscous) settles in `time` on the curve.
+fn gain_at_time(o: &Outcomes, curve: &Curve, nadf: bool, time: f64) -> Option<f64> {
+    calibration::gain_for(&times(o, curve, nadf), time)
+}
+
+/// The settling time of NADF (or viscous) at gain `k`, interpolated on the curve.
+fn time_at_gain(o: &Outcomes, curve: &Curve, nadf: bool, k: f64) -> f64 {
+    (times(o, curve, nadf).windows(2))
         .find(|w| w[0].0 <= k && k <= w[1].0)
         .map_or(f64::NAN, |w| {
             let s = (w[1].1 / w[0].1).ln() / (w[1].0 / w[0].0).ln();
@@ -1470,7 +1490,7 @@ fn proposition_3(t: &mut Table) {
         ],
     ]);
     let bias = concat(&[
-        inside,
+        inside.clone(),
         vec![
             set("agents.0.controller.clamp.kc", 10),
             set("agents.0.controller.clamp.sigma", 0.5),
@@ -1492,10 +1512,52 @@ fn proposition_3(t: &mut Table) {
         "K_c = 10 + bias, from inside σ",
         4,
     );
+    // §V: cutting the error by K (×10) against by K_c (×10), from the same start.
+    let clamp = |k: f64, kc: f64| {
+        concat(&[
+            inside.clone(),
+            vec![
+                set("agents.0.controller.k", k),
+                set("agents.0.controller.clamp.kc", kc),
+                set("agents.0.controller.clamp.sigma", 0.5),
+            ],
+        ])
+    };
+    t.run(
+        "sec5-base",
+        PAPER_ROOM,
+        &clamp(K_PAPER, 10.0),
+        "K, K_c = 10",
+        4,
+    );
+    t.run(
+        "sec5-high-k",
+        PAPER_ROOM,
+        &clamp(10.0 * K_PAPER, 10.0),
+        "10 K, K_c = 10",
+        4,
+    );
+    t.run(
+        "sec5-high-kc",
+        PAPER_ROOM,
+        &clamp(K_PAPER, 100.0),
+        "K, K_c = 100",
+        4,
+    );
     t.figure(
         "prop3",
-        "Proposition 3 and eq. 48–50 from inside σ (F = −K∇V): distance to the target",
-        Panel::Distance(vec!["prop3-stiff".into(), "prop3-bias".into()]),
+        "Proposition 3, §V and eq. 48–50 from inside σ (F = −K∇V): distance to the target",
+        Panel::Distance(
+            [
+                "prop3-stiff",
+                "prop3-bias",
+                "sec5-base",
+                "sec5-high-k",
+                "sec5-high-kc",
+            ]
+            .map(String::from)
+            .to_vec(),
+        ),
     );
     let bound = 1e3 * 32f64.sqrt() / 1e4;
     t.claim(
@@ -1510,6 +1572,39 @@ fn proposition_3(t: &mut Table) {
             Relation::AtMost(bound),
             |o| 1e3 * summary(o, "prop3-stiff").final_error,
         ),
+    );
+    t.claim(Claim::new(
+        "sec5-high-k-effort",
+        "prop3",
+        Law::Paper,
+        "Cutting the steady-state error by a higher K raises the control effort; a higher K_c does not (§V, figures 27–29)",
+        "higher K: more effort; higher K_c: not",
+        "peak force with 10 K / peak force with 10 K_c, from inside σ (read: ≥ 2)",
+        &["sec5-high-k", "sec5-high-kc"],
+        Relation::AtLeast(2.0),
+        |o| summary(o, "sec5-high-k").peak_force / summary(o, "sec5-high-kc").peak_force,
+    ));
+    t.claim(
+        Claim::new(
+            "sec5-high-kc-error",
+            "prop3",
+            Law::Paper,
+            "… while the higher K_c still cuts the steady-state error (§V)",
+            "cuts the error",
+            "final error with K_c = 100 / with K_c = 10, from inside σ (read: ≤ 0.5)",
+            &["sec5-high-kc", "sec5-base"],
+            Relation::AtMost(0.5),
+            |o| summary(o, "sec5-high-kc").final_error / summary(o, "sec5-base").final_error,
+        )
+        .or(Verdict::Differs, Relation::AtLeast(0.5), |o| {
+            format!(
+                "near the target the law's own K∇V holds the body (peak {} N): the error is {} mm with K_c = 10, {} mm with K_c = 100, {} mm with 10 K",
+                n(summary(o, "sec5-base").peak_force),
+                n(1e3 * summary(o, "sec5-base").final_error),
+                n(1e3 * summary(o, "sec5-high-kc").final_error),
+                n(1e3 * summary(o, "sec5-high-k").final_error)
+            )
+        }),
     );
     t.claim(Claim::new(
         "bias-cancels",
@@ -1841,6 +1936,41 @@ fn swap(t: &mut Table, law: Law) {
         "1 kg, no damping",
         12,
     );
+    // Under the paper's law the swap's ratio depends on K as the room's does: its curve, with
+    // the calibrated K's runs as its last point.
+    let mut curve: Curve = vec![];
+    if law == Law::Paper {
+        for k in SWAP_GAINS {
+            let gain = [
+                set("agents.0.controller.k", k),
+                set("agents.1.controller.k", k),
+            ];
+            let a = format!("swap-gain-nadf-{}", n(k));
+            t.run(
+                &a,
+                "swap.toml",
+                &concat(&[base.clone(), gain.to_vec()]),
+                &format!("K = {}", n(k)),
+                24,
+            );
+            let b = format!("swap-gain-viscous-{}", n(k));
+            let o = concat(&[base.clone(), gain.to_vec(), vec![set("duration", 200)]]);
+            t.run(&b, "swap-viscous.toml", &o, &format!("K = {}", n(k)), 40);
+            curve.push((k, a, b));
+        }
+        curve.push((K_PAPER, nadf.clone(), viscous.clone()));
+        t.figure(
+            "swap-gain",
+            "Figures 49–52 over K (the paper's law): robot 1's settling times and their ratio",
+            Panel::OverGain {
+                pairs: curve.clone(),
+                names: ("NADF B_d = 10".into(), "viscous B = 1".into()),
+                calibrated: K_PAPER,
+                paper_ratio: 6.5,
+                paper_times: (2.0, 13.0),
+            },
+        );
+    }
     let fig = format!("{p}swap");
     let short = if law == Law::Paper {
         "F = −K∇V"
@@ -1888,14 +2018,20 @@ fn swap(t: &mut Table, law: Law) {
             Relation::AtLeast(5.5),
             move |o| slower_without_contact(o, &a, &b),
         )
-        .value(6.5);
+        .value(6.5)
+        .also(&curve);
+    let swap_curve = curve.clone();
     t.claim(if law == Law::Paper {
         c.or(Verdict::Weaker, Relation::AtLeast(1.2), move |o| {
+            let k = gain_at_ratio(o, &swap_curve, 6.5);
             format!(
-                "with the room's K the open room's field is steep: the viscous robots peak at {} m/s and robot 1 settles in {} s against NADF's {} s",
-                n(summary(o, &a2).peak_speed),
+                "the ratio falls as K grows (over K: {}); at the room's K robot 1 settles in {} s against NADF's {} s; 6.5× needs K ≈ {}, where NADF takes {} s (paper 2 s) and viscous {} s (paper 13 s)",
+                ratio_curve(o, &swap_curve),
                 n(settle(o, &a2)),
-                n(settle(o, &b2))
+                n(settle(o, &b2)),
+                k.map_or("(off the sweep)".into(), n),
+                k.map_or("?".into(), |k| n(time_at_gain(o, &swap_curve, true, k))),
+                k.map_or("?".into(), |k| n(time_at_gain(o, &swap_curve, false, k)))
             )
         })
     } else {
@@ -1914,9 +2050,19 @@ fn swap(t: &mut Table, law: Law) {
         Relation::Within(13.0 * 0.8, 13.0 * 1.2),
         move |o| settle(o, &a),
     )
-    .value(13.0);
+    .value(13.0)
+    .also(&curve);
+    let swap_curve = curve.clone();
     c = c.or(Verdict::Differs, Relation::AtLeast(0.0), move |o| {
-        format!("{} s under the room's calibration", n(settle(o, &a2)))
+        if swap_curve.is_empty() {
+            format!("{} s under the room's calibration", n(settle(o, &a2)))
+        } else {
+            format!(
+                "{} s under the room's calibration; the curve over K gives 13 s at K ≈ {}",
+                n(settle(o, &a2)),
+                gain_at_time(o, &swap_curve, false, 13.0).map_or("(off the sweep)".into(), n)
+            )
+        }
     });
     t.claim(c);
     let a = nadf.clone();

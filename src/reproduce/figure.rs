@@ -36,15 +36,19 @@ pub enum Panel {
     /// The settling time against the damping coefficient, one point per run (never settled:
     /// the run's duration).
     Settling(Vec<String>),
-    /// The calibration: the settling times of NADF and viscous damping and their ratio against
-    /// the gain K (log scales), the calibrated K and the paper's ratio marked.
+    /// The settling times of NADF and viscous damping and their ratio against the gain K (log
+    /// scales), the calibrated K and the paper's numbers marked.
     OverGain {
         /// `(K, NADF run, viscous run)`, in increasing K.
         pairs: Vec<(f64, String, String)>,
+        /// The legends of the NADF and the viscous settling times.
+        names: (String, String),
         /// The calibrated gain.
         calibrated: f64,
         /// The paper's ratio.
         paper_ratio: f64,
+        /// The paper's settling times, NADF and viscous, s.
+        paper_times: (f64, f64),
     },
 }
 
@@ -92,8 +96,9 @@ fn thin(outcome: &Outcome) -> usize {
     (outcome.trace.len() / 2000).max(1)
 }
 
-/// A line of a figure: its legend, its colour's index and its points.
-type Line = (String, usize, Vec<(f64, f64)>);
+/// A line of a figure: its legend, its colour's index, its points, and whether it is a
+/// reference (a paper's number or a marked gain: drawn thin) rather than a measurement.
+type Line = (String, usize, Vec<(f64, f64)>, bool);
 
 /// One line per run (and agent) of the figure's time series or paths.
 fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
@@ -107,11 +112,13 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
                 (b, o.summary().settling_time.unwrap_or(o.world.duration))
             })
             .collect();
-        return vec![("settling time".into(), 0, points)];
+        return vec![("settling time".into(), 0, points, false)];
     }
     if let Panel::OverGain {
         pairs,
+        names,
         paper_ratio,
+        paper_times,
         calibrated,
     } = &figure.panel
     {
@@ -130,28 +137,25 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
                 .collect()
         };
         let marked = |k: f64| vec![(k, 1.0), (k, 300.0)];
+        let level = |y: f64| vec![(k0, y), (k1, y)];
+        let (tn, tv) = *paper_times;
         let lines: Vec<Line> = vec![
-            ("T_S, NADF B_d = 10 (s)".into(), 0, nadf),
-            ("T_S, viscous B = 0.7 (s)".into(), 1, viscous),
-            ("ratio viscous / NADF".into(), 2, ratio),
+            (format!("T_S, {} (s)", names.0), 0, nadf, false),
+            (format!("T_S, {} (s)", names.1), 1, viscous, false),
+            ("ratio viscous / NADF".into(), 2, ratio, false),
             (
                 format!("the paper's ratio, {paper_ratio}"),
-                3,
-                vec![(k0, *paper_ratio), (k1, *paper_ratio)],
+                2,
+                level(*paper_ratio),
+                true,
             ),
-            (
-                "the paper's T_S, 12 s".into(),
-                4,
-                vec![
-                    (k0, super::calibration::T_FIGURE_16),
-                    (k1, super::calibration::T_FIGURE_16),
-                ],
-            ),
-            ("the calibrated K".into(), 5, marked(*calibrated)),
+            (format!("the paper's T_S, {tn} s"), 0, level(tn), true),
+            (format!("the paper's T_S, {tv} s"), 1, level(tv), true),
+            ("the calibrated K".into(), 5, marked(*calibrated), true),
         ];
         return lines
             .into_iter()
-            .map(|(name, colour, points)| (name, colour, log(points)))
+            .map(|(name, colour, points, thin)| (name, colour, log(points), thin))
             .collect();
     }
     for (colour, id) in figure.runs().iter().enumerate() {
@@ -161,7 +165,7 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
         if let Panel::Angle(_) = figure.panel {
             let target = o.world.pendulums[0].target;
             let points = samples.map(|s| (s.time, target - s.pendulums[0])).collect();
-            out.push((label(id), colour, points));
+            out.push((label(id), colour, points, false));
             continue;
         }
         for (a, agent) in o.world.agents.iter().enumerate() {
@@ -201,7 +205,7 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
             } else {
                 label(id)
             };
-            out.push((name, colour, points));
+            out.push((name, colour, points, false));
         }
     }
     out
@@ -318,8 +322,13 @@ pub fn draw(figure: &Figure, outcomes: &Outcomes) -> Result<Vec<u8>, String> {
                     .map_err(e)?;
             }
         }
-        for (name, colour, points) in lines {
-            let style = PALETTE[colour % PALETTE.len()].stroke_width(2);
+        for (name, colour, points, thin) in lines {
+            let colour = PALETTE[colour % PALETTE.len()];
+            let style = if thin {
+                colour.mix(0.6).stroke_width(1)
+            } else {
+                colour.stroke_width(2)
+            };
             chart
                 .draw_series(LineSeries::new(points, style))
                 .map_err(e)?

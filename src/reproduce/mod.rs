@@ -227,27 +227,13 @@ pub fn select(only: &[String]) -> Result<(Vec<Claim>, Vec<figure::Figure>), Repr
     Ok((chosen, figures))
 }
 
-/// Whether any of `claims` reasons with the calibration's curves (the room's claims do) or
-/// the calibration is drawn.
-fn needs_calibration(claims: &[Claim], figures: &[figure::Figure]) -> bool {
-    claims.iter().any(|c| c.figure.contains("room"))
-        || figures.iter().any(|f| f.id.starts_with("calibration"))
-}
-
-/// Every experiment `claims` and `figures` need, each once, in the table's order (with the
-/// calibration's sweeps whenever a claim of the room is asked for: its reasons read them).
+/// Every experiment `claims` and `figures` need, each once, in the table's order.
 pub fn needed(claims: &[Claim], figures: &[figure::Figure]) -> Vec<Experiment> {
     experiments()
         .into_iter()
         .filter(|e| {
             claims.iter().any(|c| c.runs.contains(&e.id))
                 || figures.iter().any(|f| f.runs().contains(&e.id))
-                || needs_calibration(claims, figures)
-                    && [Law::Paper, Law::Normalized].iter().any(|&law| {
-                        sweep(law)
-                            .iter()
-                            .any(|&k| [true, false].iter().any(|&n| gain_run(law, n, k) == e.id))
-                    })
         })
         .collect()
 }
