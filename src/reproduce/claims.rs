@@ -78,16 +78,6 @@ pub enum Verdict {
     NotApplicable,
 }
 
-impl Verdict {
-    /// Every verdict, in the report's order.
-    pub const ALL: [Verdict; 4] = [
-        Self::Reproduced,
-        Self::Weaker,
-        Self::Differs,
-        Self::NotApplicable,
-    ];
-}
-
 impl fmt::Display for Verdict {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
@@ -120,6 +110,14 @@ pub enum Law {
 impl Law {
     /// Every law, in the report's order.
     pub const ALL: [Law; 4] = [Self::Paper, Self::Normalized, Self::Explicit, Self::Outside];
+
+    /// How a figure's title names the guidance law it runs.
+    pub fn short(&self) -> &'static str {
+        match self {
+            Self::Normalized => "normalized",
+            _ => "F = −K∇V",
+        }
+    }
 
     /// How the report names it.
     pub fn title(&self) -> &'static str {
@@ -651,11 +649,7 @@ fn room(t: &mut Table, law: Law) {
     let p = tag(law);
     let fig = |s: &str| format!("{p}{s}");
     let id = |s: &str| format!("{p}room-{s}");
-    let short = if law == Law::Paper {
-        "F = −K∇V"
-    } else {
-        "normalized"
-    };
+    let short = law.short();
     for b in NADF_B {
         let o = concat(&[under(law, 1), damping(0, "nadf", b)]);
         t.run(
@@ -1172,11 +1166,7 @@ fn speed_limit(t: &mut Table, law: Law) {
     t.run(&limited, PAPER_ROOM, &o, "v_max = 5 m/s", 12);
     let free = format!("{p}room-nadf-10");
     let fig = format!("{p}speed-limit");
-    let short = if law == Law::Paper {
-        "F = −K∇V"
-    } else {
-        "normalized"
-    };
+    let short = law.short();
     t.figure(
         &fig,
         &format!("Figures 19–22: speed with and without a 5 m/s limit ({short})"),
@@ -1260,11 +1250,7 @@ fn speed_limit(t: &mut Table, law: Law) {
 /// §V and §VI.4–5: the drift of eq. 71, the clamp, the bias, the sliding mode, sensor noise.
 fn drift(t: &mut Table, law: Law) {
     let p = tag(law);
-    let short = if law == Law::Paper {
-        "F = −K∇V"
-    } else {
-        "normalized"
-    };
+    let short = law.short();
     let drift = concat(&[
         under(law, 1),
         damping(0, "nadf", 10.0),
@@ -1936,6 +1922,22 @@ fn swap(t: &mut Table, law: Law) {
         "1 kg, no damping",
         12,
     );
+    let explicit = "explicit-swap-undamped";
+    if law == Law::Paper {
+        let o = concat(&[
+            under(Law::Explicit, 2),
+            damping(0, "viscous", 0.0),
+            damping(1, "viscous", 0.0),
+            vec![set("duration", 60)],
+        ]);
+        t.run(
+            explicit,
+            "swap.toml",
+            &o,
+            "1 kg, no damping, explicit step",
+            12,
+        );
+    }
     // Under the paper's law the swap's ratio depends on K as the room's does: its curve, with
     // the calibrated K's runs as its last point.
     let mut curve: Curve = vec![];
@@ -1972,11 +1974,7 @@ fn swap(t: &mut Table, law: Law) {
         );
     }
     let fig = format!("{p}swap");
-    let short = if law == Law::Paper {
-        "F = −K∇V"
-    } else {
-        "normalized"
-    };
+    let short = law.short();
     t.figure(
         &fig,
         &format!("Figures 48–52: two robots swap places ({short}, to scale)"),
@@ -1995,16 +1993,31 @@ fn swap(t: &mut Table, law: Law) {
         move |o| arrived(o, &a),
     );
     t.claim(if law == Law::Paper {
-        c.or(Verdict::Differs, Relation::AtLeast(1.0), move |o| {
-            let e = energies(outcome(o, &a2), K_PAPER);
-            format!(
-                "with no damping both robots still settle: their energy falls to {} of its start before the target disc — the sandbox's exact step integrates the field's curvature implicitly (any K is stable), which dissipates",
-                n(e.last().copied().unwrap_or(f64::NAN) / e.first().copied().unwrap_or(f64::NAN))
-            )
-        })
+        c.also(&vec![(0.0, explicit.to_string(), explicit.to_string())])
+            .or(Verdict::Differs, Relation::AtLeast(1.0), move |o| {
+                let e = energies(outcome(o, &a2), K_PAPER);
+                format!(
+                    "with no damping both robots still settle: their energy falls to {} of its start before the target disc, so the sandbox's exact step dissipates (it integrates the field's curvature implicitly, so that any K is stable); with the explicit step {} of 2 arrive (next entry)",
+                    n(e.last().copied().unwrap_or(f64::NAN) / e.first().copied().unwrap_or(f64::NAN)),
+                    n(arrived(o, explicit))
+                )
+            })
     } else {
         c
     });
+    if law == Law::Paper {
+        t.claim(Claim::new(
+            "explicit-fig48-fails",
+            &fig,
+            Law::Explicit,
+            "With the explicit step: 1 kg robots without damping, and the planner totally fails (figure 48)",
+            "totally fails",
+            "robots that arrive without contact (of 2)",
+            &[explicit],
+            Relation::AtMost(0.0),
+            move |o| arrived(o, explicit),
+        ));
+    }
     let (a, b) = (viscous.clone(), nadf.clone());
     let (a2, b2) = (viscous.clone(), nadf.clone());
     let c = Claim::new(
