@@ -153,7 +153,7 @@ pub struct Check {
 pub struct Claim {
     /// Its id.
     pub id: String,
-    /// The figure it belongs to (an id of [`Table::figures`]).
+    /// The figure it belongs to (an id of one of [`figures`](super::figures)).
     pub figure: String,
     /// The law it is measured under.
     pub law: Law,
