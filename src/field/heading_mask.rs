@@ -367,8 +367,9 @@ mod tests {
         (grid, walls, l)
     }
 
-    /// The body at `(x, y, θ)` as parry shapes, and whether it touches a wall or leaves the box,
-    /// and its distance to the walls and the box.
+    /// The clearance of the body at `(x, y, θ)`, judged by parry: its smallest distance to a
+    /// wall or to the edge of the `size`-metre box (negative where a vertex is outside the box;
+    /// 0 where it touches or overlaps a wall), m.
     fn clearance(walls: &[WallShape], parts: &[Vec<[f64; 2]>], pose: [f64; 3], size: f64) -> f64 {
         let [x, y, theta] = pose;
         let at = Pose::new(Vector::new(x as f32, y as f32), theta as f32);
