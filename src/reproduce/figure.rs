@@ -5,7 +5,7 @@
 
 use plotters::prelude::*;
 
-use super::{Outcome, Outcomes, experiments};
+use super::{Outcome, Outcomes};
 use crate::chart::{PALETTE, padded, register_font};
 use crate::world::wall_outline;
 
@@ -83,14 +83,6 @@ impl Figure {
     }
 }
 
-/// The legend of experiment `id`.
-fn label(id: &str) -> String {
-    experiments()
-        .into_iter()
-        .find(|e| e.id == id)
-        .map_or("?".into(), |e| e.label)
-}
-
 /// Every `n`-th sample, so a line has at most about 2000 points.
 fn thin(outcome: &Outcome) -> usize {
     (outcome.trace.len() / 2000).max(1)
@@ -165,7 +157,7 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
         if let Panel::Angle(_) = figure.panel {
             let target = o.world.pendulums[0].target;
             let points = samples.map(|s| (s.time, target - s.pendulums[0])).collect();
-            out.push((label(id), colour, points, false));
+            out.push((o.label.clone(), colour, points, false));
             continue;
         }
         for (a, agent) in o.world.agents.iter().enumerate() {
@@ -201,9 +193,9 @@ fn lines(figure: &Figure, outcomes: &Outcomes) -> Vec<Line> {
                 points.extend(samples.clone().map(point));
             }
             let name = if o.world.agents.len() > 1 {
-                format!("{} ({})", label(id), agent.name)
+                format!("{} ({})", o.label, agent.name)
             } else {
-                label(id)
+                o.label.clone()
             };
             out.push((name, colour, points, false));
         }

@@ -20,8 +20,8 @@ pub mod figure;
 pub mod report;
 
 pub use claims::{
-    Check, Claim, Experiment, Law, Relation, Verdict, calibrated_gain, claims, experiments,
-    figures, gain_of, gain_run, settle, sweep,
+    Check, Claim, Experiment, Law, Relation, Verdict, calibrated_gain, calibration_curve, claims,
+    experiments, figures, gain_of, gain_run, settle, sweep,
 };
 
 use std::collections::BTreeMap;
@@ -95,6 +95,8 @@ pub struct Sample {
 /// What one experiment gave.
 #[derive(Debug, Clone)]
 pub struct Outcome {
+    /// The legend of the experiment's line in a figure.
+    pub label: String,
     /// The world as run (with the experiment's overrides).
     pub world: World,
     /// Each agent's summary.
@@ -192,6 +194,7 @@ pub fn run_one(experiment: &Experiment) -> Result<Outcome, ReproduceError> {
         });
     }
     Ok(Outcome {
+        label: experiment.label.clone(),
         agents: sim.summaries(),
         pendulums: sim.pendulum_summaries(),
         world,

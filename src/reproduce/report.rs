@@ -11,7 +11,9 @@ use serde::Serialize;
 
 use super::calibration::{self, K_NORMALIZED, K_PAPER, PULL};
 use super::figure::Figure;
-use super::{Checked, Claim, Law, Outcomes, Verdict, calibrated_gain, gain_run, settle, sweep};
+use super::{
+    Checked, Claim, Law, Outcomes, Verdict, calibrated_gain, calibration_curve, gain_run, sweep,
+};
 
 /// One claim in `report.json`.
 #[derive(Debug, Clone, Serialize)]
@@ -105,16 +107,7 @@ pub fn calibrations(outcomes: &Outcomes) -> Vec<Calibration> {
             law,
             declared: super::gain_of(law),
             derived: calibrated_gain(law, outcomes),
-            sweep: sweep(law)
-                .into_iter()
-                .map(|k| {
-                    (
-                        k,
-                        settle(outcomes, &gain_run(law, true, k)),
-                        settle(outcomes, &gain_run(law, false, k)),
-                    )
-                })
-                .collect(),
+            sweep: calibration_curve(law, outcomes),
         })
         .collect()
 }
