@@ -8,8 +8,9 @@
 //! = 0.3` (δ_m is at most 0.3 m). The metrics and their units come from the summary's declaration, so
 //! a new metric can be expected without a change here.
 
-use crate::metrics::{Kind, Metric, Summary, Value, metrics_of, values_of};
+use crate::metrics::{Kind, Measured, Metric, Summary, Value, metrics_of, values_of};
 use crate::sim::pendulum::PendulumSummary;
+use crate::sim::shaped::ShapedSummary;
 use crate::world::suggest::closest;
 use crate::world::{Expect, ExpectValue, World};
 
@@ -75,7 +76,13 @@ impl Bound {
 /// The bounds of an `[expect]` table, in the order of the summary's metrics (at least, at
 /// most, exactly), or every key that is not a valid expectation, as `(key, message)`.
 pub fn bounds(e: &Expect) -> Result<Vec<Bound>, Vec<(String, String)>> {
-    let metrics = metrics_of::<Summary>();
+    bounds_of::<Summary>(e)
+}
+
+/// [`bounds`] against the metrics of another summary (a shaped agent's, which has the heading's
+/// metrics too).
+pub fn bounds_of<T: Measured>(e: &Expect) -> Result<Vec<Bound>, Vec<(String, String)>> {
+    let metrics = metrics_of::<T>();
     let mut bounds = Vec::new();
     let mut problems = Vec::new();
     for (key, value) in &e.0 {
@@ -194,7 +201,12 @@ fn bound(metrics: &[Metric], key: &str, value: ExpectValue) -> Result<Bound, Str
 /// The expectations in `e` that `s` misses. (`e` was validated when the world was loaded; an
 /// expectation that is not valid is reported as missed.)
 pub fn check(e: &Expect, s: &Summary) -> Vec<String> {
-    let bounds = match bounds(e) {
+    check_of(e, s)
+}
+
+/// [`check`] for any summary.
+pub fn check_of<T: Measured>(e: &Expect, s: &T) -> Vec<String> {
+    let bounds = match bounds_of::<T>(e) {
         Ok(bounds) => bounds,
         Err(problems) => {
             return problems
@@ -220,6 +232,22 @@ pub fn failures(world: &World, summaries: &[Summary]) -> Vec<String> {
                 check(expect, summary)
                     .into_iter()
                     .map(|m| format!("{}: {m}", summary.name)),
+            );
+        }
+    }
+    out
+}
+
+/// Every expectation of `world` (its `[expect]` and each shaped agent's) that these shaped
+/// agents' summaries miss, as readable lines.
+pub fn shaped_failures(world: &World, summaries: &[ShapedSummary]) -> Vec<String> {
+    let mut out = Vec::new();
+    for (agent, summary) in world.shaped.iter().zip(summaries) {
+        for expect in [&world.expect, &agent.expect].into_iter().flatten() {
+            out.extend(
+                check_of(expect, summary)
+                    .into_iter()
+                    .map(|m| format!("{}: {m}", summary.summary.name)),
             );
         }
     }

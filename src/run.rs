@@ -13,6 +13,7 @@ use crate::output::{self, OutputError};
 use crate::record::{RecordError, Recorder, Viewer};
 use crate::sim::Simulation;
 use crate::sim::pendulum::PendulumSummary;
+use crate::sim::shaped::ShapedSummary;
 use crate::world::World;
 
 /// What a run writes.
@@ -62,6 +63,9 @@ pub struct Report {
     /// One summary per pendulum, in the world file's order (left out of the JSON when none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pendulums: Vec<PendulumSummary>,
+    /// One summary per shaped agent, in the world file's order (left out of the JSON when none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub shaped: Vec<ShapedSummary>,
     /// Wall-clock time of the whole run (fields, simulation, recording).
     #[serde(skip)]
     pub wall_time: Duration,
@@ -91,6 +95,8 @@ pub struct FieldStats {
     pub relative_residual: f64,
     /// Wall-clock time of the solve.
     pub solve_time: Duration,
+    /// For a shaped agent: the heading cells of its (x, y, θ) grid and the time its mask took.
+    pub headings: Option<(usize, Duration)>,
 }
 
 /// Simulates `world` to its duration.
@@ -129,8 +135,18 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
                 solves: field.solves,
                 relative_residual: field.relative_residual,
                 solve_time: field.solve_time,
+                headings: None,
             })
         })
+        .chain(sim.shaped.iter().map(|s| FieldStats {
+            agent: s.agent.name.clone(),
+            cells: [s.field.grid().nx, s.field.grid().ny],
+            iterations: s.field.iterations,
+            solves: s.field.solves,
+            relative_residual: s.field.relative_residual,
+            solve_time: s.field.solve_time,
+            headings: Some((s.field.mask.headings, s.field.mask_time)),
+        }))
         .collect();
     let mut recorder = match (&options.recording, &options.viewer) {
         (None, None) => None,
@@ -181,8 +197,14 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
     }
     if let Some(r) = &mut recorder {
         let summaries = sim.summaries();
-        let failures = crate::expect::failures(world, &summaries);
-        let mut markdown = format!("```\n{}```\n\n", metrics::table(&summaries));
+        let shaped = sim.shaped_summaries();
+        let mut failures = crate::expect::failures(world, &summaries);
+        failures.extend(crate::expect::shaped_failures(world, &shaped));
+        let mut markdown = format!(
+            "```\n{}{}```\n\n",
+            metrics::table(&summaries),
+            shaped_table(&shaped)
+        );
         markdown += &match (interrupted_at, failures.is_empty()) {
             (Some(t), _) => format!("**Interrupted** at {t:.2} s.\n"),
             (None, true) => "No expectation failed.\n".to_string(),
@@ -206,6 +228,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         world: world.name().to_string(),
         agents: sim.summaries(),
         pendulums: sim.pendulum_summaries(),
+        shaped: sim.shaped_summaries(),
         wall_time: started.elapsed(),
         recording,
         fields,
@@ -215,6 +238,27 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         output::write_atomically(path, report.to_json().as_bytes())?;
     }
     Ok(report)
+}
+
+/// The shaped agents' summaries as a table (the disc's columns), and one line each for the
+/// heading.
+fn shaped_table(shaped: &[ShapedSummary]) -> String {
+    if shaped.is_empty() {
+        return String::new();
+    }
+    let summaries: Vec<Summary> = shaped.iter().map(|s| s.summary.clone()).collect();
+    let mut out = metrics::table(&summaries);
+    for s in shaped {
+        out += &format!(
+            "{}: final heading {:.4} rad, heading error {}, peak angular speed {:.2} rad/s\n",
+            s.summary.name,
+            s.final_heading,
+            s.heading_error
+                .map_or_else(|| "- (any heading)".to_string(), |e| format!("{e:.4} rad")),
+            s.peak_angular_speed
+        );
+    }
+    out
 }
 
 impl Report {
@@ -227,8 +271,15 @@ impl Report {
     pub fn table(&self) -> String {
         let mut out = String::new();
         for f in &self.fields {
+            let (headings, mask) = match f.headings {
+                Some((n, t)) => (
+                    format!(" x {n} headings"),
+                    format!(", mask {:.0} ms", t.as_secs_f64() * 1e3),
+                ),
+                None => (String::new(), String::new()),
+            };
             out += &format!(
-                "field of {}: {} x {} cells, {} solve(s), {} iterations, relative residual {:.1e}, {:.0} ms\n",
+                "field of {}: {} x {} cells{headings}{mask}, {} solve(s), {} iterations, relative residual {:.1e}, {:.0} ms\n",
                 f.agent,
                 f.cells[0],
                 f.cells[1],
@@ -239,6 +290,7 @@ impl Report {
             );
         }
         out += &metrics::table(&self.agents);
+        out += &shaped_table(&self.shaped);
         if !self.pendulums.is_empty() {
             out += &format!(
                 "{:<12} {:>12} {:>9} {:>12} {:>8} {:>7}\n",

@@ -767,3 +767,80 @@ fn spawn_without_a_viewer_and_a_bad_url_are_clear_errors() {
     );
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
+
+/// A shaped agent's run (issue 26): its recording has the shape in its moving frame (a
+/// transform per step), the kinematic path with its heading marks, the field's slice and the
+/// heading plot; `nadf field` exports its (x, y, θ) field as `[nx, ny, headings]` arrays.
+#[test]
+fn a_shaped_agents_run_is_recorded_and_its_field_exported() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("couch-door.toml");
+    let world = world.to_str().unwrap();
+    let out = nadf(
+        dir.path(),
+        // Two seconds: on its way, not there yet.
+        &[
+            "run",
+            world,
+            "--set",
+            "duration=2",
+            "--set",
+            "expect.reached=false",
+            "-o",
+            "couch.rrd",
+        ],
+    );
+    common::assert_success(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("x 96 headings") && stdout.contains("couch"),
+        "{stdout}"
+    );
+    let recording = Recording::read(&dir.path().join("couch.rrd"));
+    recording.assert_has(&[
+        "agents/couch/body/shape",
+        "agents/couch/kinematic_path",
+        "agents/couch/kinematic_poses",
+        "agents/couch/target",
+        "agents/couch/field/potential",
+        "plots/couch/heading[θ (rad)]",
+        "plots/couch/heading[θ − θ_T (rad)]",
+    ]);
+    // 2 s at 5 ms: a pose per step.
+    assert_eq!(
+        recording.rows("agents/couch/body", "Transform3D:rotation_axis_angle"),
+        400
+    );
+    let out = nadf(
+        dir.path(),
+        &["field", world, "--npy", "couch.npy", "--png", "couch.png"],
+    );
+    common::assert_success(&out);
+    let read = |name: &str| {
+        let bytes = std::fs::read(dir.path().join(name)).unwrap();
+        let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        let header = String::from_utf8(bytes[10..10 + header_len].to_vec()).unwrap();
+        (header, bytes[10 + header_len..].to_vec())
+    };
+    let (header, mask) = read("couch.mask.npy");
+    assert!(header.contains("'shape': (161, 101, 96)"), "{header}");
+    let (_, w) = read("couch.w.npy");
+    let w: Vec<f64> = w
+        .chunks(8)
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    // W is 1 on the target set, in (0, 1) on the other reachable cells, 0 on blocked ones.
+    let (mut target, mut inside) = (0, 0);
+    for (m, w) in mask.iter().zip(&w) {
+        match m {
+            0 if *w == 1.0 => target += 1,
+            0 => {
+                assert!(*w > 0.0 && *w < 1.0, "{w}");
+                inside += 1;
+            }
+            _ => assert_eq!(*w, 0.0),
+        }
+    }
+    assert!(target > 0 && inside > 100_000, "{target} {inside}");
+    assert!(dir.path().join("couch.png").is_file());
+}

@@ -24,7 +24,11 @@ fn every_shipped_world_meets_its_expectations() {
     for path in worlds {
         let world = nadf::world::load(&path, &[]).unwrap();
         let has_expectations = world.expect.is_some()
-            || world.agents.iter().any(|a| a.expect.is_some())
+            || world
+                .agents
+                .iter()
+                .chain(&world.shaped)
+                .any(|a| a.expect.is_some())
             || world.pendulums.iter().any(|p| p.expect.is_some());
         assert!(has_expectations, "{} has no [expect] table", path.display());
         let dir = tempfile::tempdir().unwrap();
@@ -63,11 +67,10 @@ fn every_shipped_world_meets_its_expectations() {
         }
         // And no numerical fault along the way.
         let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
-        for (agent, settings) in summary["agents"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .zip(&world.agents)
+        let shaped = summary["shaped"].as_array().into_iter().flatten();
+        for (agent, settings) in (summary["agents"].as_array().unwrap().iter())
+            .chain(shaped)
+            .zip(world.agents.iter().chain(&world.shaped))
         {
             let faults = &agent["faults"];
             for key in [

@@ -39,7 +39,7 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
                 "{}: ok ({}, {} agent(s), {} wall(s))",
                 path.display(),
                 world.name(),
-                world.agents.len(),
+                world.agents.len() + world.shaped.len(),
                 world.walls.len()
             );
             // A lidar agent is not refused (it must find out online), but the user is told.

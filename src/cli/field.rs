@@ -3,10 +3,10 @@
 use std::path::PathBuf;
 
 use super::{Failure, bad_input, load, write_all};
-use crate::field::{HarmonicField, export};
+use crate::field::{HarmonicField, PoseField, export};
 use crate::output;
 use crate::record::field_picture;
-use crate::world::{FieldKind, Override};
+use crate::world::{BodyShape, FieldKind, Override};
 
 /// The arguments of `nadf field`.
 #[derive(Debug, Clone, clap::Args)]
@@ -16,12 +16,13 @@ pub struct FieldArgs {
     /// The agent whose field to solve [default: the first].
     #[arg(long)]
     pub agent: Option<String>,
-    /// Write V as a float64 array of shape [nx, ny] (x index first) to this file, W = 1 - V
-    /// to FILE.w.npy and the cell mask (0 reachable, 1 blocked, 2 unreachable) to
-    /// FILE.mask.npy.
+    /// Write V as a float64 array of shape [nx, ny] (x index first; [nx, ny, headings] for a
+    /// shaped agent) to this file, W = 1 - V to FILE.w.npy, log10 W to FILE.log10w.npy and the
+    /// cell mask (0 reachable, 1 blocked, 2 unreachable) to FILE.mask.npy.
     #[arg(long, value_name = "FILE.npy")]
     pub npy: Option<PathBuf>,
-    /// Write a picture of the field (log10(1 - V), streamlines, start, target).
+    /// Write a picture of the field (log10(1 - V), streamlines, start, target; for a shaped
+    /// agent, the slice of its (x, y, θ) field at its start heading).
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
     /// Override a world value by dotted path (see `run`). Repeatable.
@@ -33,12 +34,13 @@ pub struct FieldArgs {
 pub fn field(args: &FieldArgs) -> Result<(), Failure> {
     let path = &args.world;
     let world = load(path, &args.overrides)?;
+    let everyone = || world.agents.iter().chain(&world.shaped);
     let agent = match &args.agent {
-        Some(name) => world.agents.iter().find(|a| &a.name == name),
-        None => world.agents.first(),
+        Some(name) => everyone().find(|a| &a.name == name),
+        None => everyone().next(),
     };
     let Some(agent) = agent else {
-        let names: Vec<&str> = world.agents.iter().map(|a| a.name.as_str()).collect();
+        let names: Vec<&str> = everyone().map(|a| a.name.as_str()).collect();
         return Err(bad_input(
             path,
             format!(
@@ -52,6 +54,9 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
     let outputs = npy.iter().flatten().chain(&args.png);
     for out in outputs {
         output::check_file(out).map_err(|e| bad_input(path, e))?;
+    }
+    if agent.is_shaped() {
+        return pose_field(path, &world, agent, npy, args.png.as_deref());
     }
     if world.field.kind != FieldKind::Harmonic {
         eprintln!(
@@ -99,6 +104,62 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
     if let Some(png) = &args.png {
         let (rgb, width, height) = field_picture(&field, agent);
         files.push((png.clone(), export::png(&rgb, width, height)));
+    }
+    write_all(path, files)
+}
+
+/// `nadf field` for a shaped agent: its (x, y, θ) field, the arrays `[nx, ny, headings]`, and
+/// the picture of the slice at its start heading.
+fn pose_field(
+    path: &std::path::Path,
+    world: &crate::world::World,
+    agent: &crate::world::Agent,
+    npy: Option<[PathBuf; 4]>,
+    png: Option<&std::path::Path>,
+) -> Result<(), Failure> {
+    let shape = BodyShape::of_agent(agent)
+        .map_err(|e| bad_input(path, e))?
+        .expect("a shaped agent");
+    let inertia = agent.inertia.unwrap_or_else(|| shape.inertia(agent.mass));
+    let rho = (inertia / agent.mass).sqrt();
+    let field = PoseField::solve(world, agent, &shape, rho).map_err(|e| bad_input(path, e))?;
+    let (grid, d) = (field.grid(), field.dims());
+    let reachable = field.reachable.iter().filter(|r| **r).count();
+    let blocked = field.mask.blocked.iter().filter(|b| **b).count();
+    println!(
+        "field of {}: {} x {} cells of {} m x {} headings ({reachable} reachable, {blocked} blocked, {} unreachable); ρ = {rho:.4} m",
+        agent.name,
+        grid.nx,
+        grid.ny,
+        grid.cell,
+        d.nt,
+        d.len() - reachable - blocked
+    );
+    println!(
+        "mask: {:.1} ms (margin {:.4} m); solve: {:.1} ms, {} solve(s), {} CG iterations, relative residual {:.1e}",
+        field.mask_time.as_secs_f64() * 1e3,
+        field.mask.margin,
+        field.solve_time.as_secs_f64() * 1e3,
+        field.solves,
+        field.iterations,
+        field.relative_residual
+    );
+    let start = [agent.start[0], agent.start[1], agent.heading];
+    println!(
+        "1 - V at the start: {}",
+        scientific(field.log10_one_minus_potential(start))
+    );
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    if let Some(paths) = npy {
+        files.extend(paths.into_iter().zip(export::pose_arrays(&field)));
+    }
+    if let Some(png) = png {
+        let deepest = crate::record::deepest(&field);
+        let (rgb, [w, h]) = crate::record::pose_slice_image(&field, agent.heading, deepest);
+        // Row 0 of the image is the grid's bottom row: flipped so that y is up in the picture.
+        let row = 3 * w as usize;
+        let flipped: Vec<u8> = rgb.chunks(row).rev().flatten().copied().collect();
+        files.push((png.to_path_buf(), export::png(&flipped, w, h)));
     }
     write_all(path, files)
 }

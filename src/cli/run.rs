@@ -92,6 +92,7 @@ pub fn run(args: &RunArgs, console: &Console) -> Result<(), Failure> {
     }
     let mut failures = crate::expect::failures(&world, &report.agents);
     failures.extend(crate::expect::pendulum_failures(&world, &report.pendulums));
+    failures.extend(crate::expect::shaped_failures(&world, &report.shaped));
     if failures.is_empty() {
         return Ok(());
     }

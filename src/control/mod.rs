@@ -205,7 +205,7 @@ impl<const N: usize> Controller<N> {
     }
 }
 
-impl Controller<2> {
+impl<const N: usize> Controller<N> {
     /// The controller a world file's `[agents.controller]` table describes (validated: the
     /// parameters its kind needs are present) for a body of `mass` kg.
     pub fn from_settings(settings: &ControllerSettings, guidance: GuidanceKind, mass: f64) -> Self {
@@ -219,7 +219,7 @@ impl Controller<2> {
             },
         };
         let b = settings.b.unwrap_or(0.0);
-        let laws: Vec<Box<dyn ControlLaw<2>>> = match settings.kind {
+        let laws: Vec<Box<dyn ControlLaw<N>>> = match settings.kind {
             ControllerKind::Nadf => vec![Box::new(guidance), Box::new(Nadf { b_d: b })],
             ControllerKind::Viscous => vec![Box::new(guidance), Box::new(Viscous { b })],
             ControllerKind::SlidingMode => vec![Box::new(SlidingMode {

@@ -1,10 +1,11 @@
 //! Writing a solved field for other tools: NumPy `.npy` arrays (read with `numpy.load`).
 //!
 //! Arrays have shape `[nx, ny]`, x index first: element `[i, j]` is cell `(i, j)`, whose centre
-//! is `grid.origin + ((i + ½)·h, (j + ½)·h)`.
+//! is `grid.origin + ((i + ½)·h, (j + ½)·h)`. A shaped agent's field has shape
+//! `[nx, ny, headings]`: element `[i, j, k]` is that cell at the heading `k · 2π / headings`.
 
-use super::HarmonicField;
 use super::grid::Grid;
+use super::{HarmonicField, PoseField};
 
 /// The class of a cell in the mask array, stored as its `u8` value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -20,24 +21,77 @@ pub enum CellClass {
 
 /// An `.npy` file (format 1.0) holding a C-ordered `[nx, ny]` array of `descr` elements.
 fn npy(grid: &Grid, descr: &str, element_bytes: usize, data: impl Fn(usize) -> Vec<u8>) -> Vec<u8> {
+    let cells = (0..grid.nx).flat_map(|i| (0..grid.ny).map(move |j| grid.index(i, j)));
+    npy_of(&[grid.nx, grid.ny], descr, element_bytes, cells.map(data))
+}
+
+/// An `.npy` file of a C-ordered array of `shape`, its elements' bytes in that order.
+fn npy_of(
+    shape: &[usize],
+    descr: &str,
+    element_bytes: usize,
+    elements: impl Iterator<Item = Vec<u8>>,
+) -> Vec<u8> {
+    let dims: Vec<String> = shape.iter().map(ToString::to_string).collect();
     let mut header = format!(
-        "{{'descr': '{descr}', 'fortran_order': False, 'shape': ({}, {}), }}",
-        grid.nx, grid.ny
+        "{{'descr': '{descr}', 'fortran_order': False, 'shape': ({}), }}",
+        dims.join(", ")
     );
     // Magic (6) + version (2) + length (2) + header + newline, padded to a multiple of 64.
     let unpadded = 10 + header.len() + 1;
     header.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
     header.push('\n');
-    let mut out = Vec::with_capacity(10 + header.len() + grid.len() * element_bytes);
+    let len: usize = shape.iter().product();
+    let mut out = Vec::with_capacity(10 + header.len() + len * element_bytes);
     out.extend_from_slice(b"\x93NUMPY\x01\x00");
     out.extend_from_slice(&(header.len() as u16).to_le_bytes());
     out.extend_from_slice(header.as_bytes());
-    for i in 0..grid.nx {
-        for j in 0..grid.ny {
-            out.extend_from_slice(&data(grid.index(i, j)));
-        }
+    for e in elements {
+        out.extend_from_slice(&e);
     }
     out
+}
+
+/// An `[nx, ny, headings]` array of a shaped agent's field.
+fn pose_npy(
+    field: &PoseField,
+    descr: &str,
+    element_bytes: usize,
+    data: impl Fn(usize) -> Vec<u8>,
+) -> Vec<u8> {
+    let d = field.dims();
+    let cells = (0..d.nx)
+        .flat_map(move |i| (0..d.ny).flat_map(move |j| (0..d.nt).map(move |k| d.index(i, j, k))));
+    npy_of(&[d.nx, d.ny, d.nt], descr, element_bytes, cells.map(data))
+}
+
+/// The four arrays of a shaped agent's field, as for a disc's: `V`, `W = 1 − V`, `log10 W` and
+/// the mask, each `[nx, ny, headings]`.
+pub fn pose_arrays(field: &PoseField) -> [Vec<u8>; 4] {
+    let w = &field.w;
+    let class = |c: usize| {
+        if field.mask.blocked[c] {
+            CellClass::Blocked
+        } else if field.reachable[c] {
+            CellClass::Reachable
+        } else {
+            CellClass::Unreachable
+        }
+    };
+    let value = |c: usize| if field.reachable[c] { w.value(c) } else { 0.0 };
+    let log = |c: usize| {
+        if field.reachable[c] {
+            w.log10(c)
+        } else {
+            f64::NEG_INFINITY
+        }
+    };
+    [
+        pose_npy(field, "<f8", 8, |c| (1.0 - value(c)).to_le_bytes().to_vec()),
+        pose_npy(field, "<f8", 8, |c| value(c).to_le_bytes().to_vec()),
+        pose_npy(field, "<f8", 8, |c| log(c).to_le_bytes().to_vec()),
+        pose_npy(field, "|u1", 1, |c| vec![class(c) as u8]),
+    ]
 }
 
 /// `V = 1 − W` per cell as little-endian float64 (exactly 1 where `W` is below 1e-16).

@@ -33,6 +33,7 @@ mod laplace;
 mod mask;
 mod multigrid;
 mod nested;
+mod pose;
 mod sample;
 mod scaled;
 mod streamline;
@@ -46,6 +47,7 @@ pub use heading_mask::{HeadingMask, ShapeError};
 pub use known::{Beam, KnownMap};
 pub use mask::{CellCounts, Disc, FreeSpace};
 pub use nested::LevelStats;
+pub use pose::{Pose, PoseField, angle_difference};
 pub use sample::Sampler;
 pub use scaled::ScaledW;
 pub use streamline::Streamline;
@@ -58,6 +60,7 @@ pub mod solvers {
     pub use super::laplace::solve_sor;
     pub use super::multigrid::{set_portable, solve};
     pub use super::nested::MAX_ITERATIONS;
+    pub use super::pose::multigrid::{Dims, solve as solve_pose};
 }
 
 /// Why a field could not be built for an agent.
@@ -82,6 +85,14 @@ pub enum FieldError {
         agent: String,
         /// The agent's radius, m.
         radius: f64,
+    },
+    /// No sequence of free poses connects a shaped agent's start pose to its target.
+    #[error(
+        "agent `{agent}`: no sequence of poses of its shape connects its start (at its heading) to its target on the (x, y, θ) grid: the task is intractable (a wider passage, a smaller shape, or a finer field.cell or more field.headings may make it tractable)"
+    )]
+    PoseUnreachable {
+        /// The agent's name.
+        agent: String,
     },
     /// The field gives no direction at the agent's start.
     #[error(

@@ -204,14 +204,14 @@ macro_rules! measured {
         $(#[$attr:meta])*
         pub struct $name:ident {
             $(
-                $(#[doc = $doc:literal])*
+                $(#[$field_attr:meta])*
                 pub $field:ident: $ty:ty $([$($how:ident($arg:expr)),* $(,)?])?,
             )*
         }
     ) => {
         $(#[$attr])*
         pub struct $name {
-            $( $(#[doc = $doc])* pub $field: $ty, )*
+            $( $(#[$field_attr])* pub $field: $ty, )*
         }
 
         impl $crate::metrics::Measured for $name {

@@ -28,7 +28,8 @@ use rerun::{
 };
 
 use super::names::{
-    AGENT_PLOTS, AGENTS, AgentPaths, PENDULUM_PLOTS, Plot, SIM_TIME, SUMMARY, WORLD, plot,
+    AGENT_PLOTS, AGENTS, AgentPaths, PENDULUM_PLOTS, Plot, SHAPED_PLOTS, SIM_TIME, SUMMARY, WORLD,
+    plot,
 };
 use crate::world::World;
 
@@ -166,7 +167,7 @@ fn layout(world: &World) -> (Blueprint, Settings) {
     }
     // The trails are logged a segment at a time: each view shows them up to the cursor.
     for view in &spatial_views {
-        for agent in &world.agents {
+        for agent in world.agents.iter().chain(&world.shaped) {
             settings.up_to_cursor(view, &format!("/{}", AgentPaths::of(&agent.name).trail));
         }
     }
@@ -178,6 +179,7 @@ fn layout(world: &World) -> (Blueprint, Settings) {
             .into()
     };
     let mut views = plot_views(AGENT_PLOTS, &world.agents, |a| a.name.as_str());
+    views.extend(plot_views(SHAPED_PLOTS, &world.shaped, |a| a.name.as_str()));
     views.extend(plot_views(PENDULUM_PLOTS, &world.pendulums, |p| {
         p.name.as_str()
     }));

@@ -1,7 +1,7 @@
 //! The potential as a picture: `log10(1 - V)` through a perceptual colour map.
 
 use super::palette::{BLOCKED, UNREACHABLE};
-use crate::field::HarmonicField;
+use crate::field::{HarmonicField, PoseField};
 
 /// The agent's field as RGB bytes, row `j` of the image being grid row `j` (y up in the world;
 /// the recording's transforms put it the right way up), and the image's `[width, height]`.
@@ -37,6 +37,40 @@ pub fn potential_image(field: &HarmonicField) -> (Vec<u8>, [u32; 2]) {
         rgb.extend_from_slice(&colour);
     }
     (rgb, [grid.nx as u32, grid.ny as u32])
+}
+
+/// The slice of a shaped agent's field that holds `theta`, as `potential_image` draws a
+/// plane field (colours scaled to the deepest cell of the whole field, so that slices compare).
+pub fn pose_slice_image(field: &PoseField, theta: f64, deepest: f64) -> (Vec<u8>, [u32; 2]) {
+    let grid = *field.grid();
+    let k = field.mask.slice_of(theta);
+    let logs = field.slice_log10(theta);
+    let mut rgb = Vec::with_capacity(grid.len() * 3);
+    for (c, &l) in logs.iter().enumerate() {
+        let colour = if field.mask.blocked[k * grid.len() + c] {
+            BLOCKED
+        } else if !l.is_finite() {
+            UNREACHABLE
+        } else {
+            let t = if deepest < 0.0 {
+                1.0 - l / deepest
+            } else {
+                1.0
+            };
+            viridis(t)
+        };
+        rgb.extend_from_slice(&colour);
+    }
+    (rgb, [grid.nx as u32, grid.ny as u32])
+}
+
+/// The deepest `log10(1 − V)` of a shaped agent's field (0 if it is 1 everywhere).
+pub fn deepest(field: &PoseField) -> f64 {
+    (0..field.w.len())
+        .filter(|&c| field.reachable[c])
+        .map(|c| field.w.log10(c))
+        .filter(|l| l.is_finite())
+        .fold(0.0, f64::min)
 }
 
 /// The viridis colour map at `t ∈ [0, 1]` (piecewise linear through 9 of its stops).

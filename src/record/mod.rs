@@ -27,6 +27,14 @@
 //!   (β x, β y, N; with a bias). A plot keeps only the rows that start or end a run of equal
 //!   values (`columns::Runs`): a flag's plot is a few rows, not one a step.
 //!
+//! - A shaped agent (`[agents.shape]`), under `agents/NAME/` too: `body` is a frame with its pose
+//!   per step (translation and rotation) and `body/shape` its outline in that frame (static);
+//!   `kinematic_path` and `kinematic_poses` (the shape every 0.5 m along it: the heading marks),
+//!   `start` and `target` (the shape at those poses; the target disc without a target
+//!   heading), `field/potential` (the slice of its (x, y, θ) field at its current heading,
+//!   logged again whenever it turns into another slice), `trail`, `contacts`, `events`; and
+//!   `plots/NAME/{distance, heading, speed, control, clearance}`.
+//!
 //! - `summary`: the run's verdict (the summary table and the expectations), a text document.
 //! - `world/pendulums/NAME/{pivot, target, rod, bob}`: a pendulum; `…/events` its bias updates
 //!   (INFO); `plots/NAME/{theta, torque, bias}`: (θ(t), θ_T), u(t) and β(t).
@@ -49,8 +57,10 @@ mod names;
 mod palette;
 mod pendulums;
 mod picture;
+mod shaped;
 mod world;
 
+pub use colormap::{deepest, pose_slice_image};
 pub use columns::Runs;
 pub use picture::field_picture;
 
@@ -139,6 +149,7 @@ pub struct Recorder {
     /// The file being written and where it goes when it is complete, if any.
     file: Option<(PathBuf, PathBuf)>,
     steps: agents::Steps,
+    shaped: shaped::ShapedSteps,
     last_flush: std::time::Instant,
 }
 
@@ -197,6 +208,7 @@ impl Recorder {
             layout,
             file,
             steps: agents::Steps::default(),
+            shaped: shaped::ShapedSteps::default(),
             last_flush: std::time::Instant::now(),
         })
     }
@@ -207,6 +219,7 @@ impl Recorder {
         pendulums::log_setup(&self.stream, &sim.pendulums)?;
         agents::log_setup(&self.stream, sim)?;
         self.steps = agents::Steps::new(&self.stream, sim)?;
+        self.shaped = shaped::log_setup(&self.stream, sim)?;
         if let Some(layout) = self.layout.take() {
             blueprint::send(&self.stream, layout)?;
         }
@@ -227,6 +240,8 @@ impl Recorder {
     ) -> Result<(), rerun::RecordingStreamError> {
         let rec = &self.stream;
         pendulums::log_step(rec, sim.time(), &sim.pendulums)?;
+        self.shaped
+            .log_step(rec, sim.time(), &sim.shaped, sim.finished())?;
         self.steps.log_step(rec, sim, states, sim.finished())?;
         if self.last_flush.elapsed() >= FLUSH_EVERY {
             self.steps.send(rec, false)?;

@@ -4,6 +4,7 @@
 
 use crate::sim::AgentState;
 use crate::sim::pendulum::PendulumState;
+use crate::sim::shaped::ShapedState;
 use crate::world::{Agent, Pendulum};
 
 /// The timeline of the simulation's time, s.
@@ -87,6 +88,49 @@ impl AgentPaths {
     /// What the layout hides of every agent but the first: its field (they overlap).
     pub fn field_of(name: &str) -> String {
         format!("/{AGENTS}/{name}/field/**")
+    }
+}
+
+/// One shaped agent's entities (under `agents/NAME/`, as a disc's).
+pub struct ShapedPaths {
+    /// `log10(1 − V)` of the slice of its field at its current heading, as an image.
+    pub potential: String,
+    /// Its kinematic path.
+    pub kinematic_path: String,
+    /// The shape at poses along its kinematic path: the heading marks.
+    pub kinematic_poses: String,
+    /// Its target (the shape at the target heading, if it has one).
+    pub target: String,
+    /// Its start (the shape at its start pose).
+    pub start: String,
+    /// Its body: a frame with its pose per step (translation and rotation).
+    pub body: String,
+    /// The shape's outline in the body's frame.
+    pub shape: String,
+    /// Its trail.
+    pub trail: String,
+    /// Where it touches something.
+    pub contacts: String,
+    /// Contacts and faults (WARN).
+    pub events: String,
+}
+
+impl ShapedPaths {
+    /// The entities of the shaped agent called `name`.
+    pub fn of(name: &str) -> Self {
+        let path = |part: &str| format!("{AGENTS}/{name}/{part}");
+        Self {
+            potential: path("field/potential"),
+            kinematic_path: path("kinematic_path"),
+            kinematic_poses: path("kinematic_poses"),
+            target: path("target"),
+            start: path("start"),
+            body: path("body"),
+            shape: path("body/shape"),
+            trail: path("trail"),
+            contacts: path("contacts"),
+            events: path("events"),
+        }
     }
 }
 
@@ -268,6 +312,81 @@ pub const AGENT_PLOTS: &[Plot<Agent, AgentState>] = &[
                 value: |_, s| s.beta.map_or(0.0, |b| b.y),
             },
         ],
+    },
+];
+
+/// Every shaped agent's plots, in the order of the views.
+pub const SHAPED_PLOTS: &[Plot<Agent, ShapedState>] = &[
+    Plot {
+        key: "distance",
+        piecewise_constant: false,
+        view: "shape: distance to target (m)",
+        series: &[Series {
+            label: "distance to target (m)",
+            shown: always,
+            value: |_, s| s.distance,
+        }],
+    },
+    Plot {
+        key: "heading",
+        piecewise_constant: false,
+        view: "shape: heading θ (rad)",
+        series: &[
+            Series {
+                label: "θ (rad)",
+                shown: always,
+                value: |_, s| s.pose[2],
+            },
+            Series {
+                label: "θ − θ_T (rad)",
+                shown: |a| a.target_heading.is_some(),
+                value: |_, s| s.heading_error.unwrap_or(0.0),
+            },
+        ],
+    },
+    Plot {
+        key: "speed",
+        piecewise_constant: false,
+        view: "shape: speed (m/s, rad/s)",
+        series: &[
+            Series {
+                label: "speed (m/s)",
+                shown: always,
+                value: |_, s| s.velocity.norm(),
+            },
+            Series {
+                label: "angular speed (rad/s)",
+                shown: always,
+                value: |_, s| s.angular_velocity,
+            },
+        ],
+    },
+    Plot {
+        key: "control",
+        piecewise_constant: false,
+        view: "shape: control (N, N·m)",
+        series: &[
+            Series {
+                label: "|F| (N)",
+                shown: always,
+                value: |_, s| s.force.norm(),
+            },
+            Series {
+                label: "τ (N·m)",
+                shown: always,
+                value: |_, s| s.torque,
+            },
+        ],
+    },
+    Plot {
+        key: "clearance",
+        piecewise_constant: false,
+        view: "shape: clearance (m)",
+        series: &[Series {
+            label: "shape to nearest wall (m)",
+            shown: always,
+            value: |_, s| s.clearance,
+        }],
     },
 ];
 

@@ -1,6 +1,6 @@
 //! The simulation: a Rapier world with the walls as fixed colliders, each agent as a dynamic
-//! disc (`agent.rs`) and each pendulum on a revolute joint ([`pendulum`]), and the step loop
-//! that closes the control loop through it.
+//! disc (`agent.rs`) or a shape that turns ([`shaped`]), each pendulum on a revolute joint
+//! ([`pendulum`]), and the step loop that closes the control loop through it.
 //!
 //! Every step, for every agent: read its position and velocity from Rapier, sample the
 //! gradient of its field there, compute the control force, reset the body's forces and apply
@@ -22,6 +22,7 @@ pub mod lidar;
 pub mod pendulum;
 mod physics;
 mod sensor;
+pub mod shaped;
 
 use rapier2d::prelude::PhysicsWorld;
 use rayon::prelude::*;
@@ -67,6 +68,8 @@ pub struct Simulation {
     pub agents: Vec<AgentRun>,
     /// The pendulums.
     pub pendulums: Vec<pendulum::PendulumRun>,
+    /// The shaped agents (`world.shaped`), planned in (x, y, θ).
+    pub shaped: Vec<shaped::ShapedRun>,
     physics: PhysicsWorld,
     time: f64,
     steps: usize,
@@ -105,6 +108,9 @@ impl Simulation {
             .iter()
             .map(|p| pendulum::insert(&mut physics, p))
             .collect();
+        let shaped = (0..world.shaped.len())
+            .map(|index| shaped::ShapedRun::new(world, index, &mut physics))
+            .collect::<Result<_, _>>()?;
         if agents.iter().any(|a| a.lidar.is_some()) {
             // Rapier fills its scene-query structure during a step; a lidar scans before the
             // first one, and would see through every wall.
@@ -116,6 +122,7 @@ impl Simulation {
             walls,
             agents,
             pendulums,
+            shaped,
             physics,
             time: 0.0,
             steps: 0,
@@ -155,11 +162,17 @@ impl Simulation {
         for p in &mut self.pendulums {
             p.apply(&mut self.physics, self.time, self.world.dt);
         }
+        for s in &mut self.shaped {
+            s.apply(&mut self.physics, self.world.dt);
+        }
         self.physics.step();
         self.steps += 1;
         self.time = self.steps as f64 * self.world.dt;
         for p in &mut self.pendulums {
             p.observe(&self.physics, self.time);
+        }
+        for s in &mut self.shaped {
+            s.observe(&self.physics, self.time, &self.walls);
         }
         let walls = (self.walls.as_slice(), &self.index);
         let bounds = self.world.bounds();
@@ -205,6 +218,11 @@ impl Simulation {
             .iter()
             .map(|p| p.summary(self.world.external_acceleration))
             .collect()
+    }
+
+    /// Each shaped agent's summary so far.
+    pub fn shaped_summaries(&self) -> Vec<shaped::ShapedSummary> {
+        self.shaped.iter().map(shaped::ShapedRun::summary).collect()
     }
 
     /// Each agent's summary so far.

@@ -16,7 +16,7 @@ use toml_edit::{DocumentMut, Item, TableLike, Value};
 
 use super::error::{WorldError, WorldErrors, line_column};
 use super::map;
-use super::schema::{LoadedMap, World};
+use super::schema::{Agent, LoadedMap, World};
 use super::suggest::with_suggestion;
 use super::validate::{validate, warnings as unlocated_warnings};
 
@@ -263,6 +263,13 @@ fn parse(text: &str, file: &Path) -> Result<World, Vec<Problem>> {
     }
     let issues = validate(&world);
     if issues.is_empty() {
+        let mut world = world;
+        // A shaped agent is planned in (x, y, θ) and simulated by its own kind of run: the
+        // agents every other part of the sandbox handles stay discs.
+        let (shaped, discs) = std::mem::take(&mut world.agents)
+            .into_iter()
+            .partition(Agent::is_shaped);
+        (world.agents, world.shaped) = (discs, shaped);
         Ok(world)
     } else {
         Err(issues

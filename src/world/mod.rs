@@ -3,6 +3,7 @@
 //! A world is a box with walls and one or more agents, each a disc with a start, a target and
 //! a controller. See `worlds/README.md` for the format.
 
+mod body;
 mod error;
 mod load;
 pub mod map;
@@ -11,13 +12,14 @@ mod shapes;
 pub(crate) mod suggest;
 mod validate;
 
+pub use body::BodyShape;
 pub use error::{WorldError, WorldErrors};
 pub use load::{Override, WorldFile, load, load_str};
 pub use schema::{
-    Agent, Attraction, BiasSettings, ClampSettings, ControllerKind, ControllerSettings, DEFAULT_K,
-    Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind, Integration, LoadedMap, MAX_CELLS,
-    MapSettings, OUTER_WALL_THICKNESS, OrcaSettings, Pendulum, PendulumController, PendulumExpect,
-    Replan, SensorKind, SensorSettings, UnknownCells, Wall, World,
+    Agent, AgentShape, Attraction, BiasSettings, ClampSettings, ControllerKind, ControllerSettings,
+    DEFAULT_K, Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind, Integration, LoadedMap,
+    MAX_CELLS, MapSettings, OUTER_WALL_THICKNESS, OrcaSettings, Pendulum, PendulumController,
+    PendulumExpect, Replan, SensorKind, SensorSettings, UnknownCells, Wall, World,
 };
 pub use shapes::{
     WallShape, all_wall_shapes, all_walls, drawn_walls, named_walls, outer_walls, outline_box,

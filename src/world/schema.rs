@@ -60,6 +60,10 @@ pub struct World {
     /// The controlled bodies (a world needs at least one agent or pendulum).
     #[serde(default)]
     pub agents: Vec<Agent>,
+    /// The agents with a shape other than a disc (`[agents.shape]`), planned in (x, y, θ): the
+    /// loader moves them here from `agents`, which holds the discs.
+    #[serde(skip)]
+    pub shaped: Vec<Agent>,
     /// Controlled pendulums (§VI.8): a mass on a massless rod on a revolute joint, under the
     /// world's `external_acceleration` as gravity.
     #[serde(default)]
@@ -208,6 +212,10 @@ pub struct FieldSettings {
     /// `replan_window` takes its edge from it. At most `replan_window`: no coarse window.
     #[serde(default = "default_replan_reach")]
     pub replan_reach: f64,
+    /// For an agent with a shape: heading cells over a full turn of the (x, y, θ) grid (an
+    /// even number, at least 8).
+    #[serde(default = "default_headings")]
+    pub headings: i64,
     /// `attractive-repulsive`: how the target attracts.
     #[serde(default)]
     pub attraction: Attraction,
@@ -270,6 +278,7 @@ impl Default for FieldSettings {
             replan: Replan::default(),
             replan_window: default_replan_window(),
             replan_reach: default_replan_reach(),
+            headings: default_headings(),
             attraction: Attraction::default(),
             eta: None,
             rho0: None,
@@ -361,6 +370,22 @@ pub struct Agent {
     /// Mass, kg.
     #[serde(default = "default_mass")]
     pub mass: f64,
+    /// The body's shape (default: a disc of `radius`). A shape other than a disc is planned in
+    /// (x, y, θ) and rotates freely; its `start` and `target` are where its centroid is.
+    #[serde(default)]
+    pub shape: Option<AgentShape>,
+    /// The heading at the start, rad (counter-clockwise from the body frame's x axis along the
+    /// world's). Only for a shape other than a disc.
+    #[serde(default)]
+    pub heading: f64,
+    /// The heading to reach, rad; without it every heading at the target point is the target.
+    /// Only for a shape other than a disc.
+    #[serde(default)]
+    pub target_heading: Option<f64>,
+    /// Moment of inertia about the centroid, kg·m² (default: the shape's, of uniform density
+    /// and `mass`). Only for a shape other than a disc.
+    #[serde(default)]
+    pub inertia: Option<f64>,
     /// The control law.
     pub controller: ControllerSettings,
     /// Noisy sensing of the walls (default: the agent knows the walls exactly).
@@ -371,7 +396,55 @@ pub struct Agent {
     pub expect: Option<Expect>,
 }
 
+/// An agent's shape (`[agents.shape]`), in the body frame, m. Polygons are convex and
+/// counter-clockwise; a compound is a list of such parts (an L, an arrow).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum AgentShape {
+    /// A disc of the agent's `radius`: planned in the plane, as without a shape.
+    Disc,
+    /// A rectangle centred on the body frame's origin.
+    Box {
+        /// Half length along the body's x axis and half width along its y axis, m.
+        #[serde(deserialize_with = "shape_half_extents")]
+        half_extents: [f64; 2],
+    },
+    /// One convex polygon.
+    Polygon {
+        /// Its vertices, counter-clockwise, m.
+        #[serde(deserialize_with = "wall_points")]
+        points: Vec<[f64; 2]>,
+    },
+    /// Several convex polygons, for a body that is not convex.
+    Compound {
+        /// The parts, each a list of vertices, counter-clockwise, m.
+        #[serde(deserialize_with = "shape_parts")]
+        parts: Vec<Vec<[f64; 2]>>,
+    },
+}
+
+impl AgentShape {
+    /// The convex parts in the body frame as given (none for a disc).
+    pub fn parts(&self) -> Vec<Vec<[f64; 2]>> {
+        match self {
+            Self::Disc => Vec::new(),
+            Self::Box {
+                half_extents: [a, b],
+            } => {
+                vec![vec![[-a, -b], [*a, -b], [*a, *b], [-a, *b]]]
+            }
+            Self::Polygon { points } => vec![points.clone()],
+            Self::Compound { parts } => parts.clone(),
+        }
+    }
+}
+
 impl Agent {
+    /// Whether the agent is a shape planned in (x, y, θ) rather than a disc in the plane.
+    pub fn is_shaped(&self) -> bool {
+        self.shape.as_ref().is_some_and(|s| *s != AgentShape::Disc)
+    }
+
     /// The radius of the target disc, m: `target_radius`, or the agent's radius by default
     /// (the field trims the default to free space).
     pub fn target_disc(&self) -> f64 {
@@ -663,6 +736,9 @@ fn default_replan_window() -> f64 {
 fn default_replan_reach() -> f64 {
     24.0
 }
+fn default_headings() -> i64 {
+    64
+}
 fn default_tolerance() -> f64 {
     1e-12
 }
@@ -716,6 +792,22 @@ fn wall_a<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
 
 fn wall_b<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
     exactly_named(d, "b")
+}
+
+fn shape_half_extents<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    exactly_named(d, "half_extents")
+}
+
+/// A compound shape's parts, each point checked like [`exactly`].
+fn shape_parts<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Vec<[f64; 2]>>, D::Error> {
+    Vec::<Vec<Vec<f64>>>::deserialize(d)?
+        .into_iter()
+        .map(|part| {
+            part.into_iter()
+                .map(|p| fixed_length(p, Some("parts")))
+                .collect()
+        })
+        .collect()
 }
 
 /// A wall's list of points, each checked like [`exactly`].

@@ -2,9 +2,10 @@
 //! agents that start in free space. Each problem is a dotted key path and a message; the loader
 //! turns the path into a line of the file.
 
+use super::body::BodyShape;
 use super::schema::{
-    Agent, Attraction, ControllerKind, ControllerSettings, Expect, FieldKind, FieldSettings,
-    GuidanceKind, Integration, MAX_CELLS, SensorKind, SensorSettings, Wall, World,
+    Agent, AgentShape, Attraction, ControllerKind, ControllerSettings, Expect, FieldKind,
+    FieldSettings, GuidanceKind, Integration, MAX_CELLS, SensorKind, SensorSettings, Wall, World,
 };
 use super::shapes::{named_walls, wall_shape};
 
@@ -83,15 +84,25 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
     }
 
     if let Some(expect) = &world.expect {
-        check_expect(&mut bad, "expect", expect);
+        // A world with a shaped agent has it alone (see `check_shaped`): its summary's metrics.
+        if world.agents.iter().any(Agent::is_shaped) {
+            check_shaped_expect(&mut bad, "expect", expect);
+        } else {
+            check_expect(&mut bad, "expect", expect);
+        }
     }
     for (i, agent) in world.agents.iter().enumerate() {
         if let Some(expect) = &agent.expect {
-            check_expect(&mut bad, &format!("agents.{i}.expect"), expect);
+            let key = format!("agents.{i}.expect");
+            if agent.is_shaped() {
+                check_shaped_expect(&mut bad, &key, expect);
+            } else {
+                check_expect(&mut bad, &key, expect);
+            }
         }
     }
 
-    if world.agents.is_empty() && world.pendulums.is_empty() {
+    if world.agents.is_empty() && world.shaped.is_empty() && world.pendulums.is_empty() {
         bad(
             "agents".into(),
             "a world needs at least one [[agents]] or [[pendulums]] entry".into(),
@@ -122,7 +133,42 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
     for (i, agent) in world.agents.iter().enumerate() {
         check_agent(&mut bad, world, i, agent);
     }
+    if world.agents.iter().any(Agent::is_shaped) {
+        check_headings(&mut bad, world);
+    }
     issues
+}
+
+/// `field.headings` for a shaped agent: even (the solver's periodic red-black colouring), at
+/// least 8 (a slice's interval below 45°), and the (x, y, θ) grid within `field.max_cells`.
+fn check_headings(bad: &mut impl FnMut(String, String), world: &World) {
+    let n = world.field.headings;
+    if n < 8 || n % 2 != 0 {
+        bad(
+            "field.headings".into(),
+            format!(
+                "must be an even whole number of at least 8 (heading cells over a turn), got {n}"
+            ),
+        );
+        return;
+    }
+    if world.size.iter().all(|s| s.is_finite() && *s > 0.0)
+        && world.field.cell.is_finite()
+        && world.field.cell > 0.0
+    {
+        let plane = ((world.size[0] / world.field.cell).ceil() + 1.0)
+            * ((world.size[1] / world.field.cell).ceil() + 1.0);
+        let cells = plane * n as f64;
+        let limit = world.field.max_cells;
+        if cells > limit as f64 {
+            bad(
+                "field.headings".into(),
+                format!(
+                    "{n} headings of {plane:.0} cells make {cells:.0} (x, y, θ) cells, more than field.max_cells = {limit}; use fewer headings or a larger field.cell, or raise field.max_cells"
+                ),
+            );
+        }
+    }
 }
 
 /// Settings that are valid but will not work as intended, as `(key path, message)`:
@@ -475,6 +521,15 @@ fn check_expect(bad: &mut impl FnMut(String, String), key: &str, e: &Expect) {
     }
 }
 
+/// [`check_expect`] for a shaped agent, whose summary has the heading's metrics too.
+fn check_shaped_expect(bad: &mut impl FnMut(String, String), key: &str, e: &Expect) {
+    if let Err(problems) = crate::expect::bounds_of::<crate::sim::shaped::ShapedSummary>(e) {
+        for (name, message) in problems {
+            bad(format!("{key}.{name}"), message);
+        }
+    }
+}
+
 fn finite_point(bad: &mut impl FnMut(String, String), key: &str, p: [f64; 2]) -> bool {
     let ok = p.iter().all(|c| c.is_finite());
     if !ok {
@@ -602,6 +657,22 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
     finite_point(bad, &key("initial_velocity"), agent.initial_velocity);
     let start_ok = finite_point(bad, &key("start"), agent.start);
     let target_ok = finite_point(bad, &key("target"), agent.target);
+    if agent.is_shaped() {
+        check_shaped(bad, world, i, agent, start_ok && target_ok);
+        return;
+    }
+    for (name, set) in [
+        ("heading", agent.heading != 0.0),
+        ("target_heading", agent.target_heading.is_some()),
+        ("inertia", agent.inertia.is_some()),
+    ] {
+        if set {
+            bad(
+                key(name),
+                "only for an agent with a shape other than a disc ([agents.shape]): a disc does not turn".into(),
+            );
+        }
+    }
     if !(agent.radius.is_finite() && agent.radius > 0.0) {
         return;
     }
@@ -674,6 +745,184 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
             }
         }
     }
+}
+
+/// The checks of an agent with a shape planned in (x, y, θ): a valid shape, finite headings,
+/// what shaped agents support so far, and a start and a target pose clear of every wall.
+fn check_shaped(
+    bad: &mut impl FnMut(String, String),
+    world: &World,
+    i: usize,
+    agent: &Agent,
+    points_ok: bool,
+) {
+    let key = |k: &str| format!("agents.{i}.{k}");
+    let shape = agent.shape.as_ref().expect("a shaped agent");
+    let shape_key = match shape {
+        AgentShape::Box { .. } => key("shape.half_extents"),
+        AgentShape::Polygon { .. } => key("shape.points"),
+        _ => key("shape.parts"),
+    };
+    if let AgentShape::Box { half_extents } = shape
+        && !half_extents.iter().all(|h| h.is_finite() && *h > 0.0)
+    {
+        bad(
+            shape_key.clone(),
+            format!(
+                "must be two positive finite numbers, got [{}, {}]",
+                half_extents[0], half_extents[1]
+            ),
+        );
+        return;
+    }
+    if (shape.parts().iter().flatten()).any(|p| !p.iter().all(|c| c.is_finite())) {
+        bad(shape_key, "every point must be finite".into());
+        return;
+    }
+    let body = match BodyShape::of(shape) {
+        Ok(body) => body.expect("not a disc"),
+        Err(e) => {
+            bad(shape_key, e.to_string());
+            return;
+        }
+    };
+    let mut ok = points_ok;
+    if !agent.heading.is_finite() {
+        bad(
+            key("heading"),
+            format!("must be a finite angle, got {}", agent.heading),
+        );
+        ok = false;
+    }
+    if let Some(t) = agent.target_heading
+        && !t.is_finite()
+    {
+        bad(
+            key("target_heading"),
+            format!("must be a finite angle, got {t}"),
+        );
+        ok = false;
+    }
+    if let Some(inertia) = agent.inertia {
+        positive(bad, &key("inertia"), inertia);
+    }
+    if !matches!(
+        agent.controller.kind,
+        ControllerKind::Nadf | ControllerKind::Viscous
+    ) {
+        bad(
+            key("controller.kind"),
+            format!(
+                "`{}` is not available for a shaped agent yet: use `nadf` or `viscous`",
+                agent.controller.kind.name()
+            ),
+        );
+    }
+    if agent.sensor.is_some() {
+        bad(
+            key("sensor"),
+            "a shaped agent knows the walls exactly: sensors are not available for it yet".into(),
+        );
+    }
+    if world.field.kind != FieldKind::Harmonic {
+        bad(
+            "field.kind".into(),
+            "a shaped agent is guided by the harmonic field in (x, y, θ): use `harmonic`".into(),
+        );
+    }
+    if world.agents.len() > 1 {
+        bad(
+            key("shape"),
+            format!(
+                "a shaped agent must be the world's only agent for now (it has {}): other agents are not yet planned around a shape",
+                world.agents.len()
+            ),
+        );
+    }
+    if let Some(r_t) = agent.target_radius
+        && !(r_t.is_finite() && r_t > 0.0)
+    {
+        bad(
+            key("target_radius"),
+            format!("must be a positive finite number, got {r_t}"),
+        );
+    }
+    if !ok {
+        return;
+    }
+    // The start at its heading; the target at its heading, or without one at any heading of
+    // a fine set (the field needs a free pose there, whichever).
+    let any: Vec<f64> = (0..64)
+        .map(|k| k as f64 * std::f64::consts::TAU / 64.0)
+        .collect();
+    let checks = [
+        ("start", agent.start, vec![agent.heading]),
+        (
+            "target",
+            agent.target,
+            agent.target_heading.map_or(any, |t| vec![t]),
+        ),
+    ];
+    for (what, p, headings) in checks {
+        let problem = |theta: f64| pose_problem(world, &body, [p[0], p[1], theta]);
+        let problems: Vec<String> = headings
+            .iter()
+            .map(|&t| problem(t))
+            .collect::<Option<_>>()
+            .unwrap_or_default();
+        if problems.is_empty() {
+            continue;
+        }
+        let message = if headings.len() == 1 {
+            format!(
+                "[{}, {}] at heading {} rad: {}",
+                p[0], p[1], headings[0], problems[0]
+            )
+        } else {
+            format!(
+                "[{}, {}]: the shape fits at no heading there (at heading 0: {}); move the target or give a target_heading",
+                p[0], p[1], problems[0]
+            )
+        };
+        bad(key(what), message);
+    }
+}
+
+/// Why `body` cannot be at `pose` (a vertex outside the box, or a wall it overlaps or
+/// touches), or `None` when it can.
+fn pose_problem(world: &World, body: &BodyShape, pose: [f64; 3]) -> Option<String> {
+    let (lo, hi) = world.bounds();
+    if let Some(v) = (body.placed(pose).iter().flatten())
+        .find(|v| v[0] < lo[0] || v[1] < lo[1] || v[0] > hi[0] || v[1] > hi[1])
+    {
+        return Some(format!(
+            "the shape's vertex [{:.3}, {:.3}] is outside the box [{}, {}] × [{}, {}]",
+            v[0], v[1], lo[0], hi[0], lo[1], hi[1]
+        ));
+    }
+    overlapping_wall(world, body, pose).map(|wall| format!("the shape overlaps or touches {wall}"))
+}
+
+/// The first wall (described for a message) that `body` at the pose `(x, y, θ)` overlaps or
+/// touches, by parry.
+pub fn overlapping_wall(
+    world: &World,
+    body: &BodyShape,
+    [x, y, theta]: [f64; 3],
+) -> Option<String> {
+    use parry2d::math::{Pose, Vector};
+    let at = Pose::new(Vector::new(x as f32, y as f32), theta as f32);
+    let polygons = body.polygons();
+    named_walls(world)
+        .find(|(_, wall)| {
+            wall_shape(wall).is_some_and(|w| {
+                polygons.iter().any(|p| {
+                    parry2d::query::distance(&at, p, &w.pose, w.shape.as_ref())
+                        .is_ok_and(|d| d.distance <= 0.0)
+                })
+            })
+        })
+        .map(|(name, _)| name)
 }
 
 /// The first wall (described for a message) that a disc of radius `r` at `p` overlaps.

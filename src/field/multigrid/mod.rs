@@ -50,7 +50,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod cycle;
-mod kernels;
+pub(super) mod kernels;
 mod krylov;
 mod level;
 mod smoother;
