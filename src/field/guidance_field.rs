@@ -6,7 +6,7 @@ use nalgebra::{Matrix2, Vector2};
 
 use super::firas::AttractiveRepulsive;
 use super::mask::Disc;
-use super::{FieldError, HarmonicField, Streamline};
+use super::{ConfigurationSpace, FieldError, HarmonicField, Streamline};
 use crate::world::{Agent, FieldKind, World, all_wall_shapes};
 
 /// One agent's guidance potential.
@@ -81,18 +81,9 @@ impl GuidanceField {
 
     /// The curvature `∇∇V` (or `∇∇U`) at `p`, 1/m², by central differences of the gradient
     /// half a cell (1 cm for Khatib's field) either side, symmetrized; `None` where a gradient
-    /// is undefined. The integrator treats its positive part as the guidance's stiffness.
+    /// is undefined (see [`ConfigurationSpace::curvature`]).
     pub fn curvature(&self, p: [f64; 2]) -> Option<Matrix2<f64>> {
-        let h = match self {
-            Self::Harmonic(f) => 0.5 * f.grid().cell,
-            Self::AttractiveRepulsive(_) => 0.01,
-        };
-        let at = |dx: f64, dy: f64| self.gradient([p[0] + dx, p[1] + dy]);
-        let dx = (at(h, 0.0)? - at(-h, 0.0)?) / (2.0 * h);
-        let dy = (at(0.0, h)? - at(0.0, -h)?) / (2.0 * h);
-        let m = Matrix2::from_columns(&[dx, dy]);
-        let m = (m + m.transpose()) * 0.5;
-        m.iter().all(|c| c.is_finite()).then_some(m)
+        <Self as ConfigurationSpace<2>>::curvature(self, p)
     }
 
     /// The potential at `p`: `V` in [0, 1], or Khatib's `U` in metres.
@@ -124,6 +115,35 @@ impl GuidanceField {
         match self {
             Self::Harmonic(h) => h.target,
             Self::AttractiveRepulsive(f) => f.target,
+        }
+    }
+}
+
+/// A disc's configuration space: the plane, whose coordinates are already the metric ones.
+impl ConfigurationSpace<2> for GuidanceField {
+    type Config = [f64; 2];
+
+    fn offset(&self, p: [f64; 2]) -> Vector2<f64> {
+        Vector2::from(p) - Vector2::from(self.target())
+    }
+
+    fn gradient(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
+        GuidanceField::gradient(self, p)
+    }
+
+    fn potential(&self, p: [f64; 2]) -> f64 {
+        GuidanceField::potential(self, p)
+    }
+
+    fn moved(&self, mut p: [f64; 2], axis: usize, by: f64) -> [f64; 2] {
+        p[axis] += by;
+        p
+    }
+
+    fn curvature_step(&self) -> f64 {
+        match self {
+            Self::Harmonic(f) => 0.5 * f.grid().cell,
+            Self::AttractiveRepulsive(_) => 0.01,
         }
     }
 }

@@ -36,6 +36,7 @@ mod nested;
 mod pose;
 mod sample;
 mod scaled;
+mod space;
 mod streamline;
 mod window;
 
@@ -50,6 +51,7 @@ pub use nested::LevelStats;
 pub use pose::{Pose, PoseField, angle_difference};
 pub use sample::Sampler;
 pub use scaled::ScaledW;
+pub use space::ConfigurationSpace;
 pub use streamline::Streamline;
 pub use window::Window;
 

@@ -17,13 +17,14 @@
 use std::collections::HashSet;
 
 use nalgebra::Vector2;
-use rapier2d::prelude::{ColliderHandle, PhysicsWorld, RigidBodyHandle};
+use rapier2d::prelude::{ColliderHandle, PhysicsWorld};
 
+use super::body::{Body, DiscBody, Sensed, control};
 use super::faults::{FaultMonitor, Observation};
 use super::lidar::Lidar;
-use super::physics::{self, from_rapier, to_rapier};
+use super::physics::{self, from_rapier};
 use super::{CONTACT_TOLERANCE, Sensor, WallIndex};
-use crate::control::{ControlInput, ControlOutput, Controller, Neighbour, Orca, unit};
+use crate::control::{ControlOutput, Controller, Neighbour, Orca, unit};
 use crate::field::{Beam, Disc, FieldError, GuidanceField, HarmonicField, KnownMap, Streamline};
 use crate::metrics::{Metrics, Summary};
 use crate::world::{Agent, ControllerKind, GuidanceKind, Replan, SensorKind, WallShape, World};
@@ -55,7 +56,7 @@ pub struct AgentRun {
     pub metrics: Metrics,
     /// Its numerical faults so far.
     pub faults: FaultMonitor,
-    body: RigidBodyHandle,
+    body: DiscBody,
     collider: ColliderHandle,
     /// The colliders it touched after the last step.
     touching: HashSet<ColliderHandle>,
@@ -220,7 +221,7 @@ impl AgentRun {
             lidar,
             kinematic,
             faults: FaultMonitor::default(),
-            body,
+            body: DiscBody { handle: body },
             collider,
             touching: HashSet::new(),
             frozen: false,
@@ -250,7 +251,7 @@ impl AgentRun {
     /// Its disc and velocity where it is now (where it last was, at rest, if Rapier's state is
     /// not finite): an obstacle in the other agents' fields, a neighbour for ORCA.
     pub(super) fn body(&self, physics: &PhysicsWorld) -> Neighbour {
-        let body = &physics.bodies[self.body];
+        let body = &physics.bodies[self.body.handle];
         let (p, v) = (from_rapier(body.translation()), from_rapier(body.linvel()));
         let finite = p.iter().chain(v.iter()).all(|c| c.is_finite());
         Neighbour {
@@ -437,9 +438,7 @@ impl AgentRun {
             }
         }
         let force = self.log.control.map_or(Vector2::zeros(), |c| c.force);
-        let body = &mut physics.bodies[self.body];
-        body.reset_forces(false);
-        body.add_force(to_rapier(force), true);
+        self.body.actuate(physics, &force);
         self.metrics.record_force(force);
     }
 
@@ -497,10 +496,8 @@ impl AgentRun {
     /// the body for the rest of the run (the fault is logged once) and reads as the last
     /// finite position at rest, so nothing non-finite reaches the controller or the metrics.
     fn read_state(&mut self, physics: &PhysicsWorld) -> (Vector2<f64>, Vector2<f64>) {
-        let body = &physics.bodies[self.body];
-        let (x, v) = (from_rapier(body.translation()), from_rapier(body.linvel()));
-        if x.iter().chain(v.iter()).all(|c| c.is_finite()) {
-            return (x, v);
+        if let Some((x, v)) = self.body.state(physics) {
+            return (Vector2::from(x), v);
         }
         if !self.frozen {
             self.frozen = true;
@@ -576,33 +573,32 @@ impl AgentRun {
         neighbours: &[Neighbour],
     ) -> ControlOutput<2> {
         let x = x + self.position_error;
-        let offset = x - Vector2::from(self.agent.target);
-        let gradient = self.field.gradient(x.into());
-        let reference_velocity = self.orca.map(|orca| {
-            let me = Neighbour {
-                position: x,
-                velocity: v,
-                radius: self.agent.radius,
-            };
-            let preferred = orca.preferred_velocity(gradient, offset);
-            orca.velocity(&me, preferred, neighbours, dt)
-        });
-        let input = ControlInput {
-            offset,
+        let (orca, radius) = (self.orca, self.agent.radius);
+        let reference = |offset: &Vector2<f64>, gradient: Option<Vector2<f64>>| {
+            orca.map(|orca| {
+                let me = Neighbour {
+                    position: x,
+                    velocity: v,
+                    radius,
+                };
+                let preferred = orca.preferred_velocity(gradient, *offset);
+                orca.velocity(&me, preferred, neighbours, dt)
+            })
+        };
+        let sensed = Sensed {
             velocity: v,
-            gradient,
-            curvature: self
-                .gradient_guidance
-                .then(|| self.field.curvature(x.into()))
-                .flatten(),
             dt,
             touching: !self.touching.is_empty(),
-            reference_velocity,
+            curvature: self.gradient_guidance,
         };
-        let mut out = self.controller.step(&input);
-        // Finite in f64 but beyond f32's range is still not finite for Rapier.
-        if !to_rapier(out.force).is_finite() {
-            out.force = Vector2::zeros();
+        let (out, rejected) = control(
+            &self.field,
+            &mut self.controller,
+            x.into(),
+            sensed,
+            reference,
+        );
+        if rejected {
             self.log.events.extend(self.faults.rejected_force());
         }
         if out.bias_updated
@@ -611,7 +607,7 @@ impl AgentRun {
             self.metrics.record_bias_update();
             self.log.notes.push(format!(
                 "settling instant at distance {:.4} m: β ← holding force = [{:.4}, {:.4}] N (update {})",
-                input.offset.norm(),
+                (x - Vector2::from(self.agent.target)).norm(),
                 beta.x,
                 beta.y,
                 self.controller.bias.as_ref().map_or(0, |b| b.updates())

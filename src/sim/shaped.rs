@@ -19,11 +19,12 @@ use rapier2d::prelude::*;
 use serde::Serialize;
 
 use super::CONTACT_TOLERANCE;
-use super::physics::{from_rapier, to_rapier};
-use crate::control::{ControlInput, ControlOutput, Controller};
+use super::body::{Body, Sensed, TurningBody, control};
+use super::physics::from_rapier;
+use crate::control::{ControlOutput, Controller};
 use crate::field::{FieldError, PoseField, Streamline, angle_difference};
 use crate::metrics::{Faults, Metrics, Summary};
-use crate::world::{Agent, BodyShape, WallShape, World};
+use crate::world::{Agent, BodyShape, GuidanceKind, WallShape, World};
 
 /// A shaped agent in a running simulation.
 pub struct ShapedRun {
@@ -47,12 +48,12 @@ pub struct ShapedRun {
     pub metrics: Metrics,
     /// Its numerical faults so far.
     pub faults: Faults,
-    body: RigidBodyHandle,
+    body: TurningBody,
     colliders: Vec<ColliderHandle>,
     touching: HashSet<ColliderHandle>,
-    /// The heading, rad, continuous (not wrapped) since the start.
-    heading: f64,
     frozen: bool,
+    /// Whether its guidance is the gradient law, whose curvature the integrator uses.
+    gradient_guidance: bool,
     peak_angular_speed: f64,
     last: ShapedState,
 }
@@ -141,14 +142,14 @@ impl ShapedRun {
                 agent.mass as f32,
                 inertia as f32,
             ));
-        let body = physics.insert_body(builder);
+        let handle = physics.insert_body(builder);
         let colliders = (shape.polygons().into_iter())
             .map(|polygon| {
                 let collider = ColliderBuilder::new(SharedShape::new(polygon))
                     .density(0.0)
                     .friction(0.0)
                     .restitution(0.0);
-                physics.insert_collider(collider, Some(body))
+                physics.insert_collider(collider, Some(handle))
             })
             .collect();
         let controller =
@@ -173,7 +174,11 @@ impl ShapedRun {
         Ok(Self {
             metrics: Metrics::new(&agent.name, agent.start, agent.target, world.distance_at),
             controller,
-            heading: agent.heading,
+            body: TurningBody {
+                handle,
+                rho,
+                heading: agent.heading,
+            },
             agent,
             shape,
             inertia,
@@ -182,10 +187,10 @@ impl ShapedRun {
             kinematic,
             kinematic_xy,
             faults: Faults::default(),
-            body,
             colliders,
             touching: HashSet::new(),
             frozen: false,
+            gradient_guidance: world.field.guidance == GuidanceKind::Gradient,
             peak_angular_speed: 0.0,
             last,
         })
@@ -201,61 +206,35 @@ impl ShapedRun {
         &self.colliders
     }
 
-    /// The pose (heading continuous) and the velocity in `q` Rapier has, or `None` when it is
-    /// not finite.
-    fn read(&self, physics: &PhysicsWorld) -> Option<([f64; 3], Vector3<f64>)> {
-        let body = &physics.bodies[self.body];
-        let (p, v) = (from_rapier(body.translation()), from_rapier(body.linvel()));
-        let (angle, omega) = (f64::from(body.rotation().angle()), f64::from(body.angvel()));
-        let heading = self.heading + angle_difference(angle, self.heading);
-        let all = [p.x, p.y, v.x, v.y, angle, omega];
-        all.iter().all(|c| c.is_finite()).then(|| {
-            (
-                [p.x, p.y, heading],
-                Vector3::new(v.x, v.y, self.rho * omega),
-            )
-        })
-    }
-
     /// Computes the control for a step of `dt` (s) and applies it to the body.
     pub(super) fn apply(&mut self, physics: &mut PhysicsWorld, dt: f64) {
-        let control = match (self.frozen, self.read(physics)) {
+        let control = match (self.frozen, self.body.state(physics)) {
             (false, Some((pose, velocity))) => Some(self.control(pose, velocity, dt)),
             _ => None,
         };
         let f = control.map_or(Vector3::zeros(), |c| c.force);
-        let (force, torque) = (Vector2::new(f.x, f.y), self.rho * f.z);
-        let body = &mut physics.bodies[self.body];
-        body.reset_forces(false);
-        body.reset_torques(false);
-        body.add_force(to_rapier(force), true);
-        body.add_torque(torque as f32, true);
+        self.body.actuate(physics, &f);
+        let force = Vector2::new(f.x, f.y);
         self.metrics.record_force(force);
-        (self.last.force, self.last.torque) = (force, torque);
+        (self.last.force, self.last.torque) = (force, self.body.torque(&f));
         self.last.clamping = control.is_some_and(|c| c.clamping);
         self.last.speed_limited = control.is_some_and(|c| c.speed_limited);
     }
 
     fn control(&mut self, pose: [f64; 3], velocity: Vector3<f64>, dt: f64) -> ControlOutput<3> {
-        let gradient = self.field.gradient(pose);
-        let offset = self.field.offset(pose);
-        if gradient.is_none() && offset.norm() > self.field.rim() {
-            self.faults.guidance_lost_steps += 1;
-        }
-        let input = ControlInput {
-            offset,
+        let sensed = Sensed {
             velocity,
-            gradient,
-            curvature: None,
             dt,
             touching: !self.touching.is_empty(),
-            reference_velocity: None,
+            curvature: self.gradient_guidance,
         };
-        let mut out = self.controller.step(&input);
-        let torque = (self.rho * out.force.z) as f32;
-        if !(to_rapier(Vector2::new(out.force.x, out.force.y)).is_finite() && torque.is_finite()) {
-            out.force = Vector3::zeros();
+        let (out, rejected) = control(&self.field, &mut self.controller, pose, sensed, |_, _| None);
+        if rejected {
             self.faults.rejected_forces += 1;
+        }
+        if self.field.gradient(pose).is_none() && self.field.offset(pose).norm() > self.field.rim()
+        {
+            self.faults.guidance_lost_steps += 1;
         }
         out
     }
@@ -269,7 +248,7 @@ impl ShapedRun {
         walls: &[WallShape],
     ) -> ShapedState {
         let mut events = Vec::new();
-        let (pose, velocity) = match self.read(physics) {
+        let (pose, velocity) = match self.body.state(physics) {
             Some(state) => state,
             None => {
                 if !self.frozen {
@@ -282,7 +261,7 @@ impl ShapedRun {
                 (self.last.pose, Vector3::zeros())
             }
         };
-        self.heading = pose[2];
+        self.body.heading = pose[2];
         let position = Vector2::new(pose[0], pose[1]);
         let v = Vector2::new(velocity.x, velocity.y);
         let clearance = self.clearance(walls, pose);

@@ -381,6 +381,32 @@ impl PoseField {
     }
 }
 
+/// A shaped body's configuration space: `(x, y, θ)` in the metric `(x, y, ρθ)`.
+impl super::ConfigurationSpace<3> for PoseField {
+    type Config = Pose;
+
+    fn offset(&self, pose: Pose) -> Vector3<f64> {
+        PoseField::offset(self, pose)
+    }
+
+    fn gradient(&self, pose: Pose) -> Option<Vector3<f64>> {
+        PoseField::gradient(self, pose)
+    }
+
+    fn potential(&self, pose: Pose) -> f64 {
+        PoseField::potential(self, pose)
+    }
+
+    fn moved(&self, mut pose: Pose, axis: usize, by: f64) -> Pose {
+        pose[axis] += if axis == 2 { by / self.rho } else { by };
+        pose
+    }
+
+    fn curvature_step(&self) -> f64 {
+        0.5 * self.grid().cell
+    }
+}
+
 /// The free cells connected to the `target` cells through the six neighbours (θ wrapping).
 fn connected(dims: Dims, blocked: &[bool], target: &[usize], w_theta: f64) -> Vec<bool> {
     let mut reached = vec![false; dims.len()];
