@@ -49,22 +49,7 @@ impl Coarsest {
                 };
             }
         }
-        // In-place Cholesky: a = L Lᵀ, L in the lower triangle.
-        for c in 0..n {
-            let mut pivot = a[c * n + c];
-            for p in 0..c {
-                pivot -= a[c * n + p] * a[c * n + p];
-            }
-            let pivot = if pivot > 0.0 { pivot.sqrt() } else { 0.0 };
-            a[c * n + c] = pivot;
-            for r in c + 1..n {
-                let mut v = a[r * n + c];
-                for p in 0..c {
-                    v -= a[r * n + p] * a[c * n + p];
-                }
-                a[r * n + c] = if pivot > 0.0 { v / pivot } else { 0.0 };
-            }
-        }
+        super::dense::cholesky(&mut a, n);
         Self { cells, factor: a }
     }
 
@@ -75,28 +60,7 @@ impl Coarsest {
         scratch.clear();
         scratch.extend(self.cells.iter().map(|&k| f64::from(b[k])));
         let y = scratch;
-        for r in 0..n {
-            let mut v = y[r];
-            for p in 0..r {
-                v -= l[r * n + p] * y[p];
-            }
-            y[r] = if l[r * n + r] > 0.0 {
-                v / l[r * n + r]
-            } else {
-                0.0
-            };
-        }
-        for r in (0..n).rev() {
-            let mut v = y[r];
-            for p in r + 1..n {
-                v -= l[p * n + r] * y[p];
-            }
-            y[r] = if l[r * n + r] > 0.0 {
-                v / l[r * n + r]
-            } else {
-                0.0
-            };
-        }
+        super::dense::solve(l, n, y);
         for (&k, &v) in self.cells.iter().zip(y.iter()) {
             x[k] = v as f32;
         }

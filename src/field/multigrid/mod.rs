@@ -50,6 +50,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod cycle;
+pub(super) mod dense;
 pub(super) mod kernels;
 mod krylov;
 mod level;

@@ -155,7 +155,9 @@ fn solve_level(
                 let (c, s) = (outer(i, j, k), sub.index(i, j, k));
                 if pending[c] {
                     unknown[s] = true;
-                } else if values.mantissa[c] > 0.0 {
+                }
+                // The last solve's estimate of a pending cell is the starting guess.
+                if values.mantissa[c] > 0.0 {
                     w[s] = values.at_scale(c, e);
                 }
             }

@@ -25,6 +25,7 @@
 
 use rayon::prelude::*;
 
+use super::super::multigrid::dense;
 use super::super::multigrid::kernels::wide;
 
 /// Smoothing sweeps (red and black) before and after each coarse correction.
@@ -126,11 +127,11 @@ impl Level {
         ((k + 1) % nt, (k + nt - 1) % nt)
     }
 
-    /// The finest level of the `unknown` cells, with coupling `w_theta` along θ.
-    fn finest(dims: Dims, unknown: &[bool], w_theta: f32) -> Self {
+    /// A level of `dims` with no active cell.
+    fn empty(dims: Dims) -> Self {
         let (stride, slab) = (dims.nx + 2, (dims.nx + 2) * (dims.ny + 2));
         let n = slab * dims.nt;
-        let mut level = Self {
+        Self {
             dims,
             stride,
             slab,
@@ -141,7 +142,12 @@ impl Level {
             north: vec![0.0; n],
             up: vec![0.0; n],
             active: 0,
-        };
+        }
+    }
+
+    /// The finest level of the `unknown` cells, with coupling `w_theta` along θ.
+    fn finest(dims: Dims, unknown: &[bool], w_theta: f32) -> Self {
+        let mut level = Self::empty(dims);
         let on = |i: usize, j: usize, k: usize| unknown[dims.index(i, j, k)];
         for k in 0..dims.nt {
             let up = (k + 1) % dims.nt;
@@ -182,20 +188,7 @@ impl Level {
             ny: d.ny.div_ceil(2),
             nt: if halve_t { d.nt / 2 } else { d.nt },
         };
-        let (stride, slab) = (dims.nx + 2, (dims.nx + 2) * (dims.ny + 2));
-        let n = slab * dims.nt;
-        let mut c = Self {
-            dims,
-            stride,
-            slab,
-            inv_diag: vec![0.0; n],
-            diag_xy: vec![0.0; n],
-            diag_t: vec![0.0; n],
-            east: vec![0.0; n],
-            north: vec![0.0; n],
-            up: vec![0.0; n],
-            active: 0,
-        };
+        let mut c = Self::empty(dims);
         let scale_t = if halve_t { HALVED } else { 1.0 };
         for kc in 0..dims.nt {
             let slabs: &[usize] = if halve_t {
@@ -447,21 +440,7 @@ impl Coarsest {
             }
             unit[p] = 0.0;
         }
-        for c in 0..n {
-            let mut pivot = a[c * n + c];
-            for q in 0..c {
-                pivot -= a[c * n + q] * a[c * n + q];
-            }
-            let pivot = if pivot > 0.0 { pivot.sqrt() } else { 0.0 };
-            a[c * n + c] = pivot;
-            for r in c + 1..n {
-                let mut v = a[r * n + c];
-                for q in 0..c {
-                    v -= a[r * n + q] * a[c * n + q];
-                }
-                a[r * n + c] = if pivot > 0.0 { v / pivot } else { 0.0 };
-            }
-        }
+        dense::cholesky(&mut a, n);
         Self {
             cells: cells.into_iter().map(|(p, _)| p).collect(),
             factor: a,
@@ -470,30 +449,8 @@ impl Coarsest {
 
     fn solve(&self, x: &mut [f32], b: &[f32]) {
         let n = self.cells.len();
-        let l = &self.factor;
         let mut y: Vec<f64> = self.cells.iter().map(|&p| f64::from(b[p])).collect();
-        for r in 0..n {
-            let mut v = y[r];
-            for q in 0..r {
-                v -= l[r * n + q] * y[q];
-            }
-            y[r] = if l[r * n + r] > 0.0 {
-                v / l[r * n + r]
-            } else {
-                0.0
-            };
-        }
-        for r in (0..n).rev() {
-            let mut v = y[r];
-            for q in r + 1..n {
-                v -= l[q * n + r] * y[q];
-            }
-            y[r] = if l[r * n + r] > 0.0 {
-                v / l[r * n + r]
-            } else {
-                0.0
-            };
-        }
+        dense::solve(&self.factor, n, &mut y);
         for (&p, v) in self.cells.iter().zip(y) {
             x[p] = v as f32;
         }
