@@ -69,6 +69,8 @@ fn the_couch_turns_through_the_door_and_back_to_its_target_heading() {
     let (headings, s) = headings(&world);
     assert_clean(&s);
     assert!(s.heading_error.is_some_and(|e| e.abs() < 0.05), "{s:?}");
+    // The speed limit holds in the metric, |q̇|² = |v|² + ρ²ω², so on the centroid's speed too.
+    assert!(s.summary.peak_speed <= 0.5 + 1e-3, "{s:?}");
     // Through the door it lay along x (heading 0 or π, within 0.3 rad); it started and ends
     // across.
     let lengthwise = |h: f64| {
