@@ -16,6 +16,7 @@
 //! sensed walls cut the agent off) keeps the last field and logs a note once.
 
 mod agent;
+pub mod arm;
 pub mod body;
 mod clearance;
 pub mod faults;

@@ -3,6 +3,7 @@
 //! A world is a box with walls and one or more agents, each a disc with a start, a target and
 //! a controller. See `worlds/README.md` for the format.
 
+pub(crate) mod arm;
 mod body;
 mod error;
 mod load;
@@ -12,6 +13,7 @@ mod shapes;
 pub(crate) mod suggest;
 mod validate;
 
+pub use arm::{Chain, Link};
 pub use body::BodyShape;
 pub use error::{WorldError, WorldErrors};
 pub use load::{Override, WorldFile, load, load_str};
