@@ -64,7 +64,7 @@ pub mod solvers {
     pub use super::laplace::solve_sor;
     pub use super::multigrid::{set_portable, solve};
     pub use super::nested::MAX_ITERATIONS;
-    pub use super::pose::multigrid::{Dims, solve as solve_pose};
+    pub use super::pose::multigrid::{Dims, Lattice, solve as solve_pose};
 }
 
 /// Why a field could not be built for an agent.

@@ -15,7 +15,7 @@
 //! would need that too.)
 
 use super::super::scaled::{ScaledW, exponent_of};
-use super::multigrid::{self, Dims};
+use super::multigrid::{self, Dims, Lattice};
 
 /// A cell is resolved by a solve when it holds at least this fraction of the solve's scale.
 pub const DEPTH_STEP: f64 = 1e-6;
@@ -40,20 +40,20 @@ pub struct DepthStats {
     pub relative_residual: f64,
 }
 
-/// Solves for `W` on the `unknown` cells of `dims` with `W = 1` on the `target` cells and 0
-/// elsewhere, each solve to `tolerance`, at any depth.
+/// Solves for `W` on the `unknown` cells of `lattice` with `W = 1` on the `target` cells and
+/// 0 elsewhere, each solve to `tolerance`, at any depth.
 pub fn solve_w(
-    dims: Dims,
+    lattice: &Lattice,
     unknown: &[bool],
     target: &[usize],
-    w_theta: f64,
     tolerance: f64,
 ) -> (ScaledW, DepthStats) {
+    let dims = lattice.dims;
     let mut w = vec![0.0; dims.len()];
     for &t in target {
         w[t] = 1.0;
     }
-    let first = multigrid::solve(dims, unknown, &mut w, w_theta, tolerance, MAX_ITERATIONS);
+    let first = multigrid::solve(lattice, unknown, &mut w, tolerance, MAX_ITERATIONS);
     let mut stats = DepthStats {
         solves: 1,
         iterations: first.iterations,
@@ -63,11 +63,11 @@ pub fn solve_w(
     // The cells of the last solve, and its scale's exponent.
     let mut last: Vec<bool> = unknown.to_vec();
     for _ in 0..MAX_LEVELS {
-        let pending = unresolved(dims, &last, &values, w_theta);
+        let pending = unresolved(lattice, &last, &values);
         if !pending.iter().any(|p| *p) {
             break;
         }
-        let Some(level) = solve_level(dims, &pending, &mut values, w_theta, tolerance) else {
+        let Some(level) = solve_level(lattice, &pending, &mut values, tolerance) else {
             break;
         };
         stats.solves += 1;
@@ -79,7 +79,8 @@ pub fn solve_w(
 }
 
 /// The cells of the last solve (`last`) that it did not resolve (see the module).
-fn unresolved(dims: Dims, last: &[bool], values: &ScaledW, w_theta: f64) -> Vec<bool> {
+fn unresolved(lattice: &Lattice, last: &[bool], values: &ScaledW) -> Vec<bool> {
+    let dims = lattice.dims;
     let value = |c: usize| values.mantissa[c];
     let mut pending: Vec<bool> = (0..dims.len())
         .map(|c| last[c] && value(c) < DEPTH_STEP)
@@ -92,7 +93,7 @@ fn unresolved(dims: Dims, last: &[bool], values: &ScaledW, w_theta: f64) -> Vec<
         let mut next = Vec::new();
         for &c in &front {
             let (i, j, k) = coordinates(dims, c);
-            for (m, _) in dims.neighbours((i, j, k), w_theta) {
+            for (m, _) in lattice.neighbours((i, j, k)) {
                 if pending[m] && value(m) >= FLOOR {
                     pending[m] = false;
                     next.push(m);
@@ -114,21 +115,22 @@ pub fn coordinates(dims: Dims, c: usize) -> (usize, usize, usize) {
 }
 
 /// Solves the `pending` cells with the others as Dirichlet values, at the scale of the largest
-/// value next to them, over their bounding box; stores them at that scale. `None` when no
-/// pending cell has a non-zero neighbour (nothing flows in: they stay 0).
+/// value next to them, over their bounding box along the bounded x and y (the whole of a
+/// periodic axis); stores them at that scale. `None` when no pending cell has a non-zero
+/// neighbour (nothing flows in: they stay 0).
 fn solve_level(
-    dims: Dims,
+    lattice: &Lattice,
     pending: &[bool],
     values: &mut ScaledW,
-    w_theta: f64,
     tolerance: f64,
 ) -> Option<multigrid::Stats> {
+    let dims = lattice.dims;
     let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
     let mut scale: Option<(f64, i32)> = None;
     for c in (0..dims.len()).filter(|&c| pending[c]) {
         let (i, j, k) = coordinates(dims, c);
         (lo, hi) = ([lo[0].min(i), lo[1].min(j)], [hi[0].max(i), hi[1].max(j)]);
-        for (m, _) in dims.neighbours((i, j, k), w_theta) {
+        for (m, _) in lattice.neighbours((i, j, k)) {
             if !pending[m] && values.mantissa[m] > 0.0 {
                 let e = values.exponent[m] + exponent_of(values.mantissa[m]);
                 if scale.is_none_or(|(_, best)| e > best) {
@@ -139,8 +141,14 @@ fn solve_level(
     }
     let (_, e) = scale?;
     // The box around the pending cells, one cell wider for their Dirichlet neighbours.
-    let (i0, j0) = (lo[0].saturating_sub(1), lo[1].saturating_sub(1));
-    let (i1, j1) = ((hi[0] + 1).min(dims.nx - 1), (hi[1] + 1).min(dims.ny - 1));
+    let (mut i0, mut j0) = (lo[0].saturating_sub(1), lo[1].saturating_sub(1));
+    let (mut i1, mut j1) = ((hi[0] + 1).min(dims.nx - 1), (hi[1] + 1).min(dims.ny - 1));
+    if lattice.periodic[0] {
+        (i0, i1) = (0, dims.nx - 1);
+    }
+    if lattice.periodic[1] {
+        (j0, j1) = (0, dims.ny - 1);
+    }
     let sub = Dims {
         nx: i1 - i0 + 1,
         ny: j1 - j0 + 1,
@@ -163,7 +171,11 @@ fn solve_level(
             }
         }
     }
-    let stats = multigrid::solve(sub, &unknown, &mut w, w_theta, tolerance, MAX_ITERATIONS);
+    let sub_lattice = Lattice {
+        dims: sub,
+        ..*lattice
+    };
+    let stats = multigrid::solve(&sub_lattice, &unknown, &mut w, tolerance, MAX_ITERATIONS);
     for k in 0..sub.nt {
         for j in 0..sub.ny {
             for i in 0..sub.nx {
@@ -205,7 +217,7 @@ mod tests {
                 }
             }
         }
-        let (w, stats) = solve_w(dims, &unknown, &target, 0.5, 1e-12);
+        let (w, stats) = solve_w(&Lattice::pose(dims, 0.5), &unknown, &target, 1e-12);
         assert!(stats.solves > 3, "{stats:?}");
         let row: Vec<f64> = (0..dims.nx).map(|i| w.log2(dims.index(i, 2, 3))).collect();
         // Decay per cell of the slowest mode across 3 cells (zeros one beyond): cosh κ = 2 −

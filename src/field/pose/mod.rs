@@ -153,7 +153,8 @@ impl PoseField {
             unknown[t] = false;
         }
         let solved = Instant::now();
-        let (w, stats) = depth::solve_w(dims, &unknown, &target, w_theta, world.field.tolerance);
+        let lattice = multigrid::Lattice::pose(dims, w_theta);
+        let (w, stats) = depth::solve_w(&lattice, &unknown, &target, world.field.tolerance);
         field.solve_time = solved.elapsed();
         if stats.relative_residual > world.field.tolerance {
             return Err(FieldError::Solver {
