@@ -219,9 +219,9 @@ impl JointField {
         )
     }
 
-    /// `∇V` at the configuration `q` in joint coordinates (1/rad), by interpolating the
-    /// central differences of the reachable corners around it; `None` off the field.
-    pub fn gradient(&self, q: &[f64]) -> Option<DVector<f64>> {
+    /// The reachable corners of the cell around `q`, with their per-joint cells and their
+    /// multilinear weights.
+    fn corners(&self, q: &[f64]) -> Vec<(Vec<i64>, usize, f64)> {
         let n = q.len();
         let positions: Vec<(i64, f64)> = (0..n).map(|a| self.axis_position(a, q[a])).collect();
         let mut corners = Vec::new();
@@ -242,11 +242,34 @@ impl JointField {
                 corners.push((k, c, weight));
             }
         }
+        corners
+    }
+
+    /// The potential `V` at `q`, interpolated over the reachable corners (1 off the field).
+    pub fn potential(&self, q: &[f64]) -> f64 {
+        let corners = self.corners(q);
+        let Some(e) = corners.iter().map(|(_, c, _)| self.w.exponent[*c]).max() else {
+            return 1.0;
+        };
+        let total: f64 = corners.iter().map(|(_, _, w)| w).sum();
+        let w: f64 = corners
+            .iter()
+            .map(|(_, c, w)| w * self.w.at_scale(*c, e))
+            .sum();
+        1.0 - super::scaled::ldexp(w / total, e)
+    }
+
+    /// `∇V` at the configuration `q` in joint coordinates (1/rad), by interpolating the
+    /// central differences of the reachable corners around it; `None` off the field.
+    pub fn gradient(&self, q: &[f64]) -> Option<DVector<f64>> {
+        let corners = self.corners(q);
         let e = corners.iter().map(|(_, c, _)| self.w.exponent[*c]).max()?;
         let total: f64 = corners.iter().map(|(_, _, w)| w).sum();
-        let g = corners.iter().fold(DVector::zeros(n), |sum, (k, _, w)| {
-            sum + self.grad_at(k, e) * (w / total)
-        });
+        let g = corners
+            .iter()
+            .fold(DVector::zeros(q.len()), |sum, (k, _, w)| {
+                sum + self.grad_at(k, e) * (w / total)
+            });
         Some(-g.map(|c| super::scaled::ldexp(c, e)))
     }
 

@@ -1,10 +1,22 @@
-//! A planar arm in Rapier (issue 27, first part): a fixed base and one dynamic capsule per link
-//! on revolute multibody joints ([`ArmBodies`]), whose own inertia matrix (from its links' body
-//! Jacobians) the tests hold to the Lagrangian's (`world::Chain::mass_matrix`).
+//! A planar arm in Rapier (issue 27): a fixed base and one dynamic capsule per link on revolute
+//! multibody joints ([`ArmBodies`]), whose own inertia matrix (from its links' body Jacobians)
+//! the tests hold to the Lagrangian's (`world::Chain::mass_matrix`), and its control in joint
+//! space with its full dynamics ([`joint_control`]).
+//!
+//! **NADF with `D(q)`.** The laws of `control` are stated for a body of one mass. At each step
+//! the arm's inertia is factored, `D(q) = L Lᵀ` (Cholesky), and the laws act in the
+//! coordinates where it is the identity: the velocity `ṽ = Lᵀ q̇` (so `½ q̇ᵀ D q̇ = ½ |ṽ|²`), the
+//! gradient `g̃ = L⁻¹ ∇V` (so `dV = g̃ · dq̃`), the offset `Lᵀ (q − q_T)`; the law's force `f̃`
+//! (mass 1) is the joint torque `τ = L f̃` (so `τ · q̇ = f̃ · ṽ`). Then `τ = −K ∇V − B_d L M(ṽ, g̃)`
+//! and, with Rapier's dynamics `D q̈ + C q̇ = τ` (Coriolis and centripetal forces left to the
+//! plant, as the paper's controller does), `d/dt (K V + ½ q̇ᵀ D q̇) = −B_d ṽ · M(ṽ, g̃) ≤ 0`:
+//! Proposition 1. Each joint's torque acts on its link and, reversed, on the link before it.
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector, SVector};
 use rapier2d::prelude::*;
 
+use crate::control::{ControlInput, Controller};
+use crate::field::{JointField, angle_difference};
 use crate::world::Chain;
 
 /// A chain in Rapier: a fixed base body and one dynamic capsule per link on revolute multibody
@@ -97,6 +109,36 @@ impl ArmBodies {
             .collect()
     }
 
+    /// The joint velocities Rapier has, rad/s.
+    pub fn velocities(&self, physics: &PhysicsWorld) -> Vec<f64> {
+        let Some((multibody, _)) =
+            (self.joints.first()).and_then(|j| physics.multibody_joints.get(*j))
+        else {
+            return Vec::new();
+        };
+        let v = multibody.generalized_velocity();
+        let offset = v.len() - self.joints.len();
+        (0..self.joints.len())
+            .map(|i| f64::from(v[offset + i]))
+            .collect()
+    }
+
+    /// Resets the links' forces and applies the joint torques `tau` (N·m): joint `i`'s on link
+    /// `i`, and reversed on link `i − 1` (the base takes the first's reaction).
+    pub fn apply_torques(&self, physics: &mut PhysicsWorld, tau: &[f64]) {
+        for &h in &self.links {
+            let body = &mut physics.bodies[h];
+            body.reset_forces(false);
+            body.reset_torques(false);
+        }
+        for (i, &t) in tau.iter().enumerate() {
+            physics.bodies[self.links[i]].add_torque(t as f32, true);
+            if i > 0 {
+                physics.bodies[self.links[i - 1]].add_torque(-t as f32, true);
+            }
+        }
+    }
+
     /// The inertia matrix Rapier's multibody has at its current configuration:
     /// `Σ_i J_iᵀ diag(m_i, m_i, I_i) J_i` over its links' body Jacobians (refreshed by a forward
     /// kinematics pass), kg·m².
@@ -139,10 +181,51 @@ impl ArmBodies {
     }
 }
 
+/// One control step of an arm at joint angles `q` and velocities `qdot` (rad, rad/s) towards
+/// `target` (rad; `None` when the target is a set of configurations, a point for the tip):
+/// the plane's `controller` (for a body of mass 1) in the coordinates where `D(q)` is the
+/// identity (see the module), the guidance from `field`. Returns the joint torques, N·m.
+pub fn joint_control<const N: usize>(
+    (controller, field, chain): (&mut Controller<N>, &JointField, &Chain),
+    (q, qdot): (&[f64], &[f64]),
+    target: Option<&[f64]>,
+    (dt, touching): (f64, bool),
+) -> Vec<f64> {
+    let d = chain.mass_matrix(q);
+    let Some(cholesky) = d.cholesky() else {
+        return vec![0.0; N];
+    };
+    let l = cholesky.l();
+    let lt = l.transpose();
+    let v = &lt * DVector::from_column_slice(qdot);
+    let gradient = field.gradient(q).and_then(|g| l.solve_lower_triangular(&g));
+    let error = DVector::from_iterator(
+        N,
+        (0..N).map(|i| target.map_or(0.0, |t| angle_difference(q[i], t[i]))),
+    );
+    let offset = &lt * error;
+    let fixed = |x: &DVector<f64>| SVector::<f64, N>::from_iterator(x.iter().copied());
+    let input = ControlInput {
+        offset: fixed(&offset),
+        velocity: fixed(&v),
+        gradient: gradient.as_ref().map(fixed),
+        curvature: None,
+        dt,
+        touching,
+        reference_velocity: None,
+    };
+    let f = controller.step(&input).force;
+    let tau = l * DVector::from_iterator(N, f.iter().copied());
+    tau.iter().copied().collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::control::{Guidance, GuidanceMode, Nadf};
+    use crate::field::{JointAxis, JointMask, JointTarget};
     use crate::world::arm::tests::chain;
+    use crate::world::{Wall, wall_shape};
 
     /// Rapier's multibody, posed at the same joint angles, has the Lagrangian's joints, and its
     /// inertia matrix is the Lagrangian's to f32 precision, at configurations spread over the
@@ -184,5 +267,112 @@ mod tests {
                 "case {n}:\nRapier {rapier}\nLagrangian {lagrange}"
             );
         }
+    }
+
+    /// Proposition 1 with the arm's own `D(q)`: a three-link arm turning its first joint by
+    /// 2.3 rad past a post, without gravity, under the paper's `τ = −K∇V − B_d L M`, simulated by
+    /// Rapier's multibody (Coriolis and centripetal terms included), never lets
+    /// `K·V + ½ q̇ᵀ D q̇` grow outside the target set by more than integration error (Rapier's
+    /// f32 step), ends in the target set (the paper's law has no bowl inside it: the body comes
+    /// to rest where NADF stops it), and touches nothing.
+    #[test]
+    fn the_energy_of_an_arm_never_increases() {
+        let c = chain();
+        let post = wall_shape(&Wall::Disc {
+            center: [2.1, 3.0],
+            radius: 0.15,
+        })
+        .unwrap();
+        let walls = vec![post];
+        let axes = [
+            JointAxis {
+                cells: 64,
+                limits: None,
+            },
+            JointAxis {
+                cells: 64,
+                limits: None,
+            },
+            JointAxis {
+                cells: 64,
+                limits: None,
+            },
+        ];
+        let bounds = ([-1.5, -1.0], [3.5, 5.0]);
+        let mask = JointMask::build(&c, &axes, &walls, bounds);
+        let (start, goal) = ([-0.4, 0.3, 0.2], [1.9, 0.4, -0.3]);
+        let target = JointTarget::Joints {
+            q: goal.to_vec(),
+            radius: 0.25,
+        };
+        let field = JointField::solve(&c, mask, (&start, &target), 1e-12, "arm").unwrap();
+        let dt = 0.002;
+        let mut physics = super::super::physics::empty_world(dt, [0.0, 0.0]);
+        super::super::physics::insert_walls(&mut physics, &walls);
+        let arm = ArmBodies::insert(&mut physics, &c, &start);
+        let k = 20.0;
+        let laws: Vec<Box<dyn crate::control::ControlLaw<3>>> = vec![
+            Box::new(Guidance {
+                k,
+                mode: GuidanceMode::Gradient,
+            }),
+            Box::new(Nadf { b_d: 5.0 }),
+        ];
+        let mut controller = Controller::<3>::new(laws, 1.0);
+        let energy = |physics: &PhysicsWorld| {
+            let (q, v) = (arm.angles(physics), arm.velocities(physics));
+            let d = c.mass_matrix(&q);
+            let v = DVector::from_vec(v);
+            (
+                k * field.potential(&q) + 0.5 * (v.transpose() * &d * &v)[(0, 0)],
+                q,
+            )
+        };
+        let (e0, _) = energy(&physics);
+        let mut last = e0;
+        let (mut worst, mut checked, mut closest) = (0.0_f64, 0, f64::INFINITY);
+        for _ in 0..10_000 {
+            let (q, v) = (arm.angles(&physics), arm.velocities(&physics));
+            let tau = joint_control(
+                (&mut controller, &field, &c),
+                (&q, &v),
+                Some(&goal),
+                (dt, false),
+            );
+            arm.apply_torques(&mut physics, &tau);
+            physics.step();
+            let (e, q) = energy(&physics);
+            // No link touches the post (it is a capsule of its radius around its segment).
+            for (link, s) in c.links.iter().zip(c.joints(&q).windows(2)) {
+                let d = crate::field::segment_distance([s[0], s[1]], [[2.1, 3.0], [2.1, 3.0]]);
+                closest = closest.min(d - 0.15 - link.radius);
+            }
+            let inside = field
+                .mask
+                .cell_of(&q)
+                .is_some_and(|cell| field.w.value(cell) == 1.0);
+            if !inside {
+                worst = worst.max(e - last);
+                checked += 1;
+            }
+            last = e;
+        }
+        let q = arm.angles(&physics);
+        let error: f64 = q
+            .iter()
+            .zip(goal)
+            .map(|(a, b)| angle_difference(*a, b).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        println!(
+            "{checked} steps checked, largest rise {worst:e} of {e0}, {last} left; final joint error {error} rad; closest to the post {closest} m"
+        );
+        assert!(closest > 0.0, "a link touched the post");
+        assert!(checked > 500, "{checked}");
+        assert!(
+            worst <= 1e-3 * e0,
+            "the energy rose by {worst} in a step (of {e0})"
+        );
+        assert!(error < 0.25, "ended at {q:?}");
     }
 }
