@@ -9,6 +9,7 @@
 //! a new metric can be expected without a change here.
 
 use crate::metrics::{Kind, Measured, Metric, Summary, Value, metrics_of, values_of};
+use crate::sim::arm_run::ArmSummary;
 use crate::sim::pendulum::PendulumSummary;
 use crate::sim::shaped::ShapedSummary;
 use crate::world::suggest::closest;
@@ -248,6 +249,21 @@ pub fn shaped_failures(world: &World, summaries: &[ShapedSummary]) -> Vec<String
                 check_of(expect, summary)
                     .into_iter()
                     .map(|m| format!("{}: {m}", summary.summary.name)),
+            );
+        }
+    }
+    out
+}
+
+/// Every `[arms.expect]` of `world` that these arm summaries miss, as readable lines.
+pub fn arm_failures(world: &World, summaries: &[ArmSummary]) -> Vec<String> {
+    let mut out = Vec::new();
+    for (arm, summary) in world.arms.iter().zip(summaries) {
+        if let Some(expect) = &arm.expect {
+            out.extend(
+                check_of(expect, summary)
+                    .into_iter()
+                    .map(|m| format!("{}: {m}", summary.name)),
             );
         }
     }

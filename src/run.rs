@@ -12,6 +12,7 @@ use crate::metrics::{self, Summary};
 use crate::output::{self, OutputError};
 use crate::record::{RecordError, Recorder, Viewer};
 use crate::sim::Simulation;
+use crate::sim::arm_run::ArmSummary;
 use crate::sim::pendulum::PendulumSummary;
 use crate::sim::shaped::ShapedSummary;
 use crate::world::World;
@@ -66,6 +67,9 @@ pub struct Report {
     /// One summary per shaped agent, in the world file's order (left out of the JSON when none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub shaped: Vec<ShapedSummary>,
+    /// One summary per arm, in the world file's order (left out of the JSON when none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub arms: Vec<ArmSummary>,
     /// Wall-clock time of the whole run (fields, simulation, recording).
     #[serde(skip)]
     pub wall_time: Duration,
@@ -138,6 +142,15 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
                 headings: None,
             })
         })
+        .chain(sim.arms.iter().map(|a| FieldStats {
+            agent: a.settings.name.clone(),
+            cells: [a.field.lattice.dims.nx, a.field.lattice.dims.ny],
+            iterations: a.field.iterations,
+            solves: a.field.solves,
+            relative_residual: a.field.relative_residual,
+            solve_time: a.field.solve_time,
+            headings: Some((a.field.lattice.dims.nt, a.mask_time)),
+        }))
         .chain(sim.shaped.iter().map(|s| FieldStats {
             agent: s.agent.name.clone(),
             cells: [s.field.grid().nx, s.field.grid().ny],
@@ -198,12 +211,15 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
     if let Some(r) = &mut recorder {
         let summaries = sim.summaries();
         let shaped = sim.shaped_summaries();
+        let arms = sim.arm_summaries();
         let mut failures = crate::expect::failures(world, &summaries);
         failures.extend(crate::expect::shaped_failures(world, &shaped));
+        failures.extend(crate::expect::arm_failures(world, &arms));
         let mut markdown = format!(
-            "```\n{}{}```\n\n",
+            "```\n{}{}{}```\n\n",
             metrics::table(&summaries),
-            shaped_table(&shaped)
+            shaped_table(&shaped),
+            arm_table(&arms)
         );
         markdown += &match (interrupted_at, failures.is_empty()) {
             (Some(t), _) => format!("**Interrupted** at {t:.2} s.\n"),
@@ -229,6 +245,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         agents: sim.summaries(),
         pendulums: sim.pendulum_summaries(),
         shaped: sim.shaped_summaries(),
+        arms: sim.arm_summaries(),
         wall_time: started.elapsed(),
         recording,
         fields,
@@ -238,6 +255,12 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         output::write_atomically(path, report.to_json().as_bytes())?;
     }
     Ok(report)
+}
+
+/// The arms' summaries as a table.
+fn arm_table(arms: &[ArmSummary]) -> String {
+    let rows: Vec<(&str, &ArmSummary)> = arms.iter().map(|a| (a.name.as_str(), a)).collect();
+    metrics::rows_table("arm", &rows)
 }
 
 /// The shaped agents' summaries as a table (the disc's columns), and one line each for the
@@ -291,6 +314,7 @@ impl Report {
         }
         out += &metrics::table(&self.agents);
         out += &shaped_table(&self.shaped);
+        out += &arm_table(&self.arms);
         if !self.pendulums.is_empty() {
             out += &format!(
                 "{:<12} {:>12} {:>9} {:>12} {:>8} {:>7}\n",

@@ -29,7 +29,8 @@ fn every_shipped_world_meets_its_expectations() {
                 .iter()
                 .chain(&world.shaped)
                 .any(|a| a.expect.is_some())
-            || world.pendulums.iter().any(|p| p.expect.is_some());
+            || world.pendulums.iter().any(|p| p.expect.is_some())
+            || world.arms.iter().any(|a| a.expect.is_some());
         assert!(has_expectations, "{} has no [expect] table", path.display());
         let dir = tempfile::tempdir().unwrap();
         let json = dir.path().join("s.json");

@@ -93,6 +93,7 @@ pub fn run(args: &RunArgs, console: &Console) -> Result<(), Failure> {
     let mut failures = crate::expect::failures(&world, &report.agents);
     failures.extend(crate::expect::pendulum_failures(&world, &report.pendulums));
     failures.extend(crate::expect::shaped_failures(&world, &report.shaped));
+    failures.extend(crate::expect::arm_failures(&world, &report.arms));
     if failures.is_empty() {
         return Ok(());
     }

@@ -56,6 +56,8 @@ pub struct JointField {
     pub solves: usize,
     /// CG iterations over all solves.
     pub iterations: usize,
+    /// The worst final relative residual.
+    pub relative_residual: f64,
     /// Wall-clock time of the solves.
     pub solve_time: Duration,
 }
@@ -169,6 +171,7 @@ impl JointField {
             target_cells,
             solves: stats.solves,
             iterations: stats.iterations,
+            relative_residual: stats.relative_residual,
             solve_time: started.elapsed(),
         })
     }

@@ -25,7 +25,7 @@ use nalgebra::Vector2;
 use serde::Serialize;
 
 pub use measure::{Kind, Measured, Metric, Value, measurements, metrics_of, values_of};
-pub use table::{csv, field as csv_field, table};
+pub use table::{csv, field as csv_field, rows_table, table};
 
 use crate::field::Streamline;
 

@@ -4,34 +4,34 @@
 use super::measure::{Measured, Value, measurements, metrics_of, values_of};
 use super::{Faults, Summary};
 
-/// The summaries as a plain-text table: one row per agent, one column per metric declared
-/// with a column, then one line per agent that met numerical faults.
-pub fn table(summaries: &[Summary]) -> String {
-    if summaries.is_empty() {
+/// Named summaries of any kind (`T`'s metrics declared with a column) as a plain-text table
+/// whose first column is headed `label`; empty without rows.
+pub fn rows_table<T: Measured>(label: &str, rows: &[(&str, &T)]) -> String {
+    if rows.is_empty() {
         return String::new();
     }
-    let metrics: Vec<_> = metrics_of::<Summary>()
+    let metrics: Vec<_> = metrics_of::<T>()
         .into_iter()
         .enumerate()
         .filter_map(|(i, m)| Some((i, m.column?, m)))
         .collect();
-    let mut header = vec!["agent".to_string()];
+    let mut header = vec![label.to_string()];
     header.extend(metrics.iter().map(|(_, column, _)| column.to_string()));
-    let mut rows = vec![header];
-    for s in summaries {
-        let values = values_of(s);
-        let mut row = vec![s.name.clone()];
+    let mut table = vec![header];
+    for (name, s) in rows {
+        let values = values_of(*s);
+        let mut row = vec![name.to_string()];
         row.extend(metrics.iter().map(|(i, _, m)| m.show(values[*i])));
-        rows.push(row);
+        table.push(row);
     }
-    let widths: Vec<usize> = (0..rows[0].len())
+    let widths: Vec<usize> = (0..table[0].len())
         .map(|c| {
-            let widest = rows.iter().map(|r| r[c].chars().count()).max();
+            let widest = table.iter().map(|r| r[c].chars().count()).max();
             widest.unwrap_or(0).max(if c == 0 { 12 } else { 7 })
         })
         .collect();
     let mut out = String::new();
-    for row in &rows {
+    for row in &table {
         let cells: Vec<String> = row
             .iter()
             .zip(&widths)
@@ -47,6 +47,14 @@ pub fn table(summaries: &[Summary]) -> String {
         out += cells.join(" ").trim_end();
         out.push('\n');
     }
+    out
+}
+
+/// The summaries as a plain-text table: one row per agent, one column per metric declared
+/// with a column, then one line per agent that met numerical faults.
+pub fn table(summaries: &[Summary]) -> String {
+    let rows: Vec<(&str, &Summary)> = summaries.iter().map(|s| (s.name.as_str(), s)).collect();
+    let mut out = rows_table("agent", &rows);
     for s in summaries {
         if let Some(t) = s.deadlocked {
             out += &format!(

@@ -28,8 +28,8 @@ use rerun::{
 };
 
 use super::names::{
-    AGENT_PLOTS, AGENTS, AgentPaths, PENDULUM_PLOTS, Plot, SHAPED_PLOTS, SIM_TIME, SUMMARY, WORLD,
-    plot,
+    AGENT_PLOTS, AGENTS, ARM_PLOTS, AgentPaths, ArmPaths, PENDULUM_PLOTS, Plot, SHAPED_PLOTS,
+    SIM_TIME, SUMMARY, WORLD, plot,
 };
 use crate::world::World;
 
@@ -170,6 +170,9 @@ fn layout(world: &World) -> (Blueprint, Settings) {
         for agent in world.agents.iter().chain(&world.shaped) {
             settings.up_to_cursor(view, &format!("/{}", AgentPaths::of(&agent.name).trail));
         }
+        for arm in &world.arms {
+            settings.up_to_cursor(view, &format!("/{}", ArmPaths::of(&arm.name).trail));
+        }
     }
     let left: ContainerLike = if spatial_views.len() == 1 {
         spatial_views.remove(0)
@@ -180,6 +183,7 @@ fn layout(world: &World) -> (Blueprint, Settings) {
     };
     let mut views = plot_views(AGENT_PLOTS, &world.agents, |a| a.name.as_str());
     views.extend(plot_views(SHAPED_PLOTS, &world.shaped, |a| a.name.as_str()));
+    views.extend(plot_views(ARM_PLOTS, &world.arms, |a| a.name.as_str()));
     views.extend(plot_views(PENDULUM_PLOTS, &world.pendulums, |p| {
         p.name.as_str()
     }));

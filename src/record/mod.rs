@@ -35,6 +35,10 @@
 //!   logged again whenever it turns into another slice), `trail`, `contacts`, `events`; and
 //!   `plots/NAME/{distance, heading, speed, control, clearance}`.
 //!
+//! - An arm: `world/arms/NAME/{base, target}` (static), `…/links` (the capsules from joint to
+//!   joint, per step, red while touching), `…/trail` (the tip's), `…/events`; and
+//!   `plots/NAME/{joints, torques}`.
+//!
 //! - `summary`: the run's verdict (the summary table and the expectations), a text document.
 //! - `world/pendulums/NAME/{pivot, target, rod, bob}`: a pendulum; `…/events` its bias updates
 //!   (INFO); `plots/NAME/{theta, torque, bias}`: (θ(t), θ_T), u(t) and β(t).
@@ -50,6 +54,7 @@
 //! one palette (`palette.rs`); `colormap.rs` and `picture.rs` draw a field as an image.
 
 mod agents;
+mod arms;
 mod blueprint;
 mod colormap;
 mod columns;
@@ -150,6 +155,7 @@ pub struct Recorder {
     file: Option<(PathBuf, PathBuf)>,
     steps: agents::Steps,
     shaped: shaped::ShapedSteps,
+    arms: arms::ArmSteps,
     last_flush: std::time::Instant,
 }
 
@@ -209,6 +215,7 @@ impl Recorder {
             file,
             steps: agents::Steps::default(),
             shaped: shaped::ShapedSteps::default(),
+            arms: arms::ArmSteps::default(),
             last_flush: std::time::Instant::now(),
         })
     }
@@ -220,6 +227,7 @@ impl Recorder {
         agents::log_setup(&self.stream, sim)?;
         self.steps = agents::Steps::new(&self.stream, sim)?;
         self.shaped = shaped::log_setup(&self.stream, sim)?;
+        self.arms = arms::log_setup(&self.stream, &sim.arms)?;
         if let Some(layout) = self.layout.take() {
             blueprint::send(&self.stream, layout)?;
         }
@@ -242,6 +250,8 @@ impl Recorder {
         pendulums::log_step(rec, sim.time(), &sim.pendulums)?;
         self.shaped
             .log_step(rec, sim.time(), &sim.shaped, sim.finished())?;
+        self.arms
+            .log_step(rec, sim.time(), &sim.arms, sim.finished())?;
         self.steps.log_step(rec, sim, states, sim.finished())?;
         if self.last_flush.elapsed() >= FLUSH_EVERY {
             self.steps.send(rec, false)?;

@@ -3,9 +3,10 @@
 //! disagree on a name.
 
 use crate::sim::AgentState;
+use crate::sim::arm_run::ArmState;
 use crate::sim::pendulum::PendulumState;
 use crate::sim::shaped::ShapedState;
-use crate::world::{Agent, Pendulum};
+use crate::world::{Agent, ArmSettings, Pendulum};
 
 /// The timeline of the simulation's time, s.
 pub const SIM_TIME: &str = "sim_time";
@@ -133,6 +134,82 @@ impl ShapedPaths {
         }
     }
 }
+
+/// One arm's entities.
+pub struct ArmPaths {
+    /// Its links, per step: one strip from joint to joint, as wide as each capsule.
+    pub links: String,
+    /// Its tip's trail.
+    pub trail: String,
+    /// Its base (static).
+    pub base: String,
+    /// Its target: the point's disc, or the arm at the target joints (static).
+    pub target: String,
+    /// Contacts (WARN).
+    pub events: String,
+}
+
+impl ArmPaths {
+    /// The entities of the arm called `name`.
+    pub fn of(name: &str) -> Self {
+        let path = |part: &str| format!("{WORLD}/arms/{name}/{part}");
+        Self {
+            links: path("links"),
+            trail: path("trail"),
+            base: path("base"),
+            target: path("target"),
+            events: path("events"),
+        }
+    }
+}
+
+/// Every arm's plots, in the order of the views.
+pub const ARM_PLOTS: &[Plot<ArmSettings, ArmState>] = &[
+    Plot {
+        key: "joints",
+        piecewise_constant: false,
+        view: "arm: joint angles (rad)",
+        series: &[
+            Series {
+                label: "q1 (rad)",
+                shown: always,
+                value: |_, s| s.q[0],
+            },
+            Series {
+                label: "q2 (rad)",
+                shown: always,
+                value: |_, s| s.q[1],
+            },
+            Series {
+                label: "q3 (rad)",
+                shown: |a| a.links.len() > 2,
+                value: |_, s| s.q.get(2).copied().unwrap_or(0.0),
+            },
+        ],
+    },
+    Plot {
+        key: "torques",
+        piecewise_constant: false,
+        view: "arm: joint torques (N·m)",
+        series: &[
+            Series {
+                label: "τ1 (N·m)",
+                shown: always,
+                value: |_, s| s.torque[0],
+            },
+            Series {
+                label: "τ2 (N·m)",
+                shown: always,
+                value: |_, s| s.torque[1],
+            },
+            Series {
+                label: "τ3 (N·m)",
+                shown: |a| a.links.len() > 2,
+                value: |_, s| s.torque.get(2).copied().unwrap_or(0.0),
+            },
+        ],
+    },
+];
 
 /// One pendulum's entities.
 pub struct PendulumPaths {

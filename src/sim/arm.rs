@@ -29,6 +29,8 @@ pub struct ArmBodies {
     pub links: Vec<RigidBodyHandle>,
     /// The joints, from the base out.
     pub joints: Vec<MultibodyJointHandle>,
+    /// The links' capsules, from the base out.
+    pub colliders: Vec<ColliderHandle>,
 }
 
 impl ArmBodies {
@@ -42,6 +44,7 @@ impl ArmBodies {
         // Built straight along x (every joint at 0), then turned to q by the multibody.
         let mut links = Vec::new();
         let mut joints = Vec::new();
+        let mut colliders = Vec::new();
         let (mut parent, mut parent_tip) = (base, Vector::ZERO);
         let mut x = bx;
         for link in &chain.links {
@@ -63,7 +66,7 @@ impl ArmBodies {
             .density(0.0)
             .friction(0.0)
             .restitution(0.0);
-            physics.insert_collider(collider, Some(handle));
+            colliders.push(physics.insert_collider(collider, Some(handle)));
             let joint = RevoluteJointBuilder::new()
                 .local_anchor1(parent_tip)
                 .local_anchor2(Vector::new(a, 0.0))
@@ -81,6 +84,7 @@ impl ArmBodies {
             base,
             links,
             joints,
+            colliders,
         };
         if let Some((multibody, _)) = arm
             .joints
@@ -181,14 +185,25 @@ impl ArmBodies {
     }
 }
 
+/// Where an arm's controller takes its offset from the target.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Aim<'a> {
+    /// Target joint angles, rad: the offset is `q − q_T` (wrapped).
+    Joints(&'a [f64]),
+    /// A target point for the tip, m: the offset is the least-squares joint displacement that
+    /// would take the tip there to first order, `J⁺ (tip − p)` (so that the laws that need a
+    /// distance, the guidance's taper, the clamp, the brake, have one).
+    Point([f64; 2]),
+}
+
 /// One control step of an arm at joint angles `q` and velocities `qdot` (rad, rad/s) towards
-/// `target` (rad; `None` when the target is a set of configurations, a point for the tip):
+/// `aim`:
 /// the plane's `controller` (for a body of mass 1) in the coordinates where `D(q)` is the
 /// identity (see the module), the guidance from `field`. Returns the joint torques, N·m.
 pub fn joint_control<const N: usize>(
     (controller, field, chain): (&mut Controller<N>, &JointField, &Chain),
     (q, qdot): (&[f64], &[f64]),
-    target: Option<&[f64]>,
+    aim: Aim,
     (dt, touching): (f64, bool),
 ) -> Vec<f64> {
     let d = chain.mass_matrix(q);
@@ -199,10 +214,16 @@ pub fn joint_control<const N: usize>(
     let lt = l.transpose();
     let v = &lt * DVector::from_column_slice(qdot);
     let gradient = field.gradient(q).and_then(|g| l.solve_lower_triangular(&g));
-    let error = DVector::from_iterator(
-        N,
-        (0..N).map(|i| target.map_or(0.0, |t| angle_difference(q[i], t[i]))),
-    );
+    let error = match aim {
+        Aim::Joints(t) => DVector::from_iterator(N, (0..N).map(|i| angle_difference(q[i], t[i]))),
+        Aim::Point(p) => {
+            let tip = chain.tip(q);
+            let e = nalgebra::Vector2::new(tip[0] - p[0], tip[1] - p[1]);
+            let j = chain.tip_jacobian(q);
+            j.pseudo_inverse(1e-9)
+                .map_or(DVector::zeros(N), |pinv| pinv * e)
+        }
+    };
     let offset = &lt * error;
     let fixed = |x: &DVector<f64>| SVector::<f64, N>::from_iterator(x.iter().copied());
     let input = ControlInput {
@@ -336,7 +357,7 @@ mod tests {
             let tau = joint_control(
                 (&mut controller, &field, &c),
                 (&q, &v),
-                Some(&goal),
+                Aim::Joints(&goal),
                 (dt, false),
             );
             arm.apply_torques(&mut physics, &tau);

@@ -17,6 +17,7 @@
 
 mod agent;
 pub mod arm;
+pub mod arm_run;
 pub mod body;
 mod clearance;
 pub mod faults;
@@ -72,6 +73,8 @@ pub struct Simulation {
     pub pendulums: Vec<pendulum::PendulumRun>,
     /// The shaped agents (`world.shaped`), planned in (x, y, θ).
     pub shaped: Vec<shaped::ShapedRun>,
+    /// The arms, planned in joint space.
+    pub arms: Vec<arm_run::ArmRun>,
     physics: PhysicsWorld,
     time: f64,
     steps: usize,
@@ -113,6 +116,9 @@ impl Simulation {
         let shaped = (0..world.shaped.len())
             .map(|index| shaped::ShapedRun::new(world, index, &mut physics))
             .collect::<Result<_, _>>()?;
+        let arms = (0..world.arms.len())
+            .map(|index| arm_run::ArmRun::new(world, index, &mut physics, &walls))
+            .collect::<Result<_, _>>()?;
         if agents.iter().any(|a| a.lidar.is_some()) {
             // Rapier fills its scene-query structure during a step; a lidar scans before the
             // first one, and would see through every wall.
@@ -125,6 +131,7 @@ impl Simulation {
             agents,
             pendulums,
             shaped,
+            arms,
             physics,
             time: 0.0,
             steps: 0,
@@ -167,6 +174,9 @@ impl Simulation {
         for s in &mut self.shaped {
             s.apply(&mut self.physics, self.world.dt);
         }
+        for a in &mut self.arms {
+            a.apply(&mut self.physics, self.world.dt);
+        }
         self.physics.step();
         self.steps += 1;
         self.time = self.steps as f64 * self.world.dt;
@@ -175,6 +185,9 @@ impl Simulation {
         }
         for s in &mut self.shaped {
             s.observe(&self.physics, self.time, &self.walls);
+        }
+        for a in &mut self.arms {
+            a.observe(&self.physics, self.time, &self.walls);
         }
         let walls = (self.walls.as_slice(), &self.index);
         let bounds = self.world.bounds();
@@ -220,6 +233,11 @@ impl Simulation {
             .iter()
             .map(|p| p.summary(self.world.external_acceleration))
             .collect()
+    }
+
+    /// Each arm's summary so far.
+    pub fn arm_summaries(&self) -> Vec<arm_run::ArmSummary> {
+        self.arms.iter().map(arm_run::ArmRun::summary).collect()
     }
 
     /// Each shaped agent's summary so far.

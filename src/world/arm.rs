@@ -77,6 +77,20 @@ impl Chain {
         *self.joints(q).last().expect("the base")
     }
 
+    /// The tip's Jacobian `∂tip/∂q` (2 × joints), m/rad.
+    pub fn tip_jacobian(&self, q: &[f64]) -> DMatrix<f64> {
+        let phi = self.angles(q);
+        let n = self.links.len();
+        let mut j = DMatrix::zeros(2, n);
+        for k in 0..n {
+            for (link, angle) in self.links.iter().zip(&phi).skip(k) {
+                j[(0, k)] -= link.length * angle.sin();
+                j[(1, k)] += link.length * angle.cos();
+            }
+        }
+        j
+    }
+
     /// Each link's centre of mass, m.
     pub fn centres(&self, q: &[f64]) -> Vec<[f64; 2]> {
         let joints = self.joints(q);

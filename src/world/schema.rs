@@ -68,6 +68,11 @@ pub struct World {
     /// world's `external_acceleration` as gravity.
     #[serde(default)]
     pub pendulums: Vec<Pendulum>,
+    /// Planar arms: links on revolute joints from a fixed base, planned in joint space, under
+    /// the world's `external_acceleration` as gravity (an arm in a vertical plane) or none (on
+    /// a table).
+    #[serde(default)]
+    pub arms: Vec<ArmSettings>,
     /// What every agent's run must show (`nadf run` exits 1 when it does not).
     #[serde(default)]
     pub expect: Option<Expect>,
@@ -439,6 +444,29 @@ impl AgentShape {
     }
 }
 
+impl ArmSettings {
+    /// The chain its links make.
+    pub fn chain(&self) -> super::arm::Chain {
+        super::arm::Chain {
+            base: self.base,
+            links: (self.links.iter())
+                .map(|l| super::arm::Link {
+                    length: l.length,
+                    mass: l.mass,
+                    com: l.com.unwrap_or(0.5 * l.length),
+                    radius: l.radius,
+                })
+                .collect(),
+        }
+    }
+
+    /// Cells per joint of its grid.
+    pub fn cells(&self) -> usize {
+        let default = if self.links.len() >= 3 { 64 } else { 128 };
+        self.cells.map_or(default, |c| c.max(0) as usize)
+    }
+}
+
 impl Agent {
     /// Whether the agent is a shape planned in (x, y, θ) rather than a disc in the plane.
     pub fn is_shaped(&self) -> bool {
@@ -480,6 +508,78 @@ pub struct Pendulum {
     /// What this pendulum's run must show.
     #[serde(default)]
     pub expect: Option<PendulumExpect>,
+}
+
+/// One arm (`[[arms]]`): two or three links from a fixed `base`, its start and its target in
+/// joint space or as a point for its tip.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArmSettings {
+    /// Name, unique in the world; used in entity paths and the summary.
+    pub name: String,
+    /// The first joint, m.
+    #[serde(deserialize_with = "exactly")]
+    pub base: [f64; 2],
+    /// The links, from the base out (two or three).
+    #[serde(default)]
+    pub links: Vec<LinkSettings>,
+    /// The joint angles at the start, rad (each relative to the link before; the first to the
+    /// world's x axis).
+    #[serde(default)]
+    pub start: Vec<f64>,
+    /// The joint angles to reach, rad (or `target_point`).
+    #[serde(default)]
+    pub target_joints: Option<Vec<f64>>,
+    /// The point the tip must reach, m (or `target_joints`): every configuration with the tip
+    /// within `target_radius` of it is the target.
+    #[serde(default, deserialize_with = "optional_pair")]
+    pub target_point: Option<[f64; 2]>,
+    /// The target's radius: rad around `target_joints`, m around `target_point` (default 0.1).
+    #[serde(default = "default_arm_target_radius")]
+    pub target_radius: f64,
+    /// Cells per joint of the joint-space grid (even; default 128 for two links, 64 for three).
+    #[serde(default)]
+    pub cells: Option<i64>,
+    /// The control law, in joint space with the arm's inertia `D(q)`.
+    pub controller: ControllerSettings,
+    /// What this arm's run must show.
+    #[serde(default)]
+    pub expect: Option<Expect>,
+}
+
+/// One link of an arm (`[[arms.links]]`): a capsule from its joint to the next.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkSettings {
+    /// Length, joint to joint (or to the tip), m.
+    pub length: f64,
+    /// Mass, kg, with the moment of inertia of a uniform rod about its centre of mass.
+    #[serde(default = "default_mass")]
+    pub mass: f64,
+    /// Distance of the centre of mass from the link's joint, m (default: the middle).
+    #[serde(default)]
+    pub com: Option<f64>,
+    /// Radius of the capsule, m.
+    #[serde(default = "default_link_radius")]
+    pub radius: f64,
+    /// The joint's limits `[min, max]`, rad (default none: it turns freely).
+    #[serde(default, deserialize_with = "optional_pair")]
+    pub limits: Option<[f64; 2]>,
+}
+
+/// An optional pair of numbers, checked like [`exactly`].
+fn optional_pair<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+    Option::<Vec<f64>>::deserialize(d)?
+        .map(|v| fixed_length(v, None))
+        .transpose()
+}
+
+fn default_arm_target_radius() -> f64 {
+    0.1
+}
+
+fn default_link_radius() -> f64 {
+    0.05
 }
 
 /// The `[pendulums.controller]` table: `u = K·e − B·θ̇ (+ β)`.

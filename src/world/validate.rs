@@ -102,10 +102,17 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
         }
     }
 
-    if world.agents.is_empty() && world.shaped.is_empty() && world.pendulums.is_empty() {
+    for (i, arm) in world.arms.iter().enumerate() {
+        check_arm(&mut bad, world, i, arm);
+    }
+    if world.agents.is_empty()
+        && world.shaped.is_empty()
+        && world.pendulums.is_empty()
+        && world.arms.is_empty()
+    {
         bad(
             "agents".into(),
-            "a world needs at least one [[agents]] or [[pendulums]] entry".into(),
+            "a world needs at least one [[agents]], [[pendulums]] or [[arms]] entry".into(),
         );
     }
     for (i, p) in world.pendulums.iter().enumerate() {
@@ -137,6 +144,223 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
         check_headings(&mut bad, world);
     }
     issues
+}
+
+/// An arm: two or three links of positive length, mass and radius; limits with min < max and
+/// even cells; a start inside them and clear of the walls; exactly one target, within reach.
+fn check_arm(
+    bad: &mut impl FnMut(String, String),
+    world: &World,
+    i: usize,
+    arm: &crate::world::ArmSettings,
+) {
+    let key = |k: &str| format!("arms.{i}.{k}");
+    let n = arm.links.len();
+    if !(2..=3).contains(&n) {
+        let hint = if n == 1 {
+            " (a single link on a joint is a [[pendulums]] entry)"
+        } else {
+            ""
+        };
+        bad(
+            key("links"),
+            format!("an arm has two or three [[arms.links]], got {n}{hint}"),
+        );
+        return;
+    }
+    if world
+        .agents
+        .iter()
+        .chain(&world.shaped)
+        .any(|a| a.name == arm.name)
+        || world.pendulums.iter().any(|p| p.name == arm.name)
+        || world.arms[..i].iter().any(|a| a.name == arm.name)
+    {
+        bad(key("name"), format!("`{}` is used twice", arm.name));
+    }
+    finite_point(bad, &key("base"), arm.base);
+    let mut ok = true;
+    for (l, link) in arm.links.iter().enumerate() {
+        let at = |k: &str| key(&format!("links.{l}.{k}"));
+        for (name, x) in [
+            ("length", link.length),
+            ("mass", link.mass),
+            ("radius", link.radius),
+        ] {
+            if !(x.is_finite() && x > 0.0) {
+                bad(
+                    at(name),
+                    format!("must be a positive finite number, got {x}"),
+                );
+                ok = false;
+            }
+        }
+        if let Some(c) = link.com
+            && !(c.is_finite() && (0.0..=link.length).contains(&c))
+        {
+            bad(
+                at("com"),
+                format!(
+                    "must be between 0 and the link's length ({}), got {c}",
+                    link.length
+                ),
+            );
+            ok = false;
+        }
+        if let Some([lo, hi]) = link.limits
+            && !(lo.is_finite() && hi.is_finite() && lo < hi)
+        {
+            bad(
+                at("limits"),
+                format!("must be [min, max] with min < max, got [{lo}, {hi}]"),
+            );
+            ok = false;
+        }
+    }
+    let cells = arm.cells.unwrap_or(arm.cells() as i64);
+    if cells < 8 || cells % 2 != 0 {
+        bad(
+            key("cells"),
+            format!("must be an even whole number of at least 8, got {cells}"),
+        );
+        ok = false;
+    } else if (cells as f64).powi(n as i32) > world.field.max_cells as f64 {
+        bad(
+            key("cells"),
+            format!(
+                "{cells} cells per joint make {} joint-space cells, more than field.max_cells = {}",
+                (cells as f64).powi(n as i32),
+                world.field.max_cells
+            ),
+        );
+        ok = false;
+    }
+    for (name, q) in [
+        ("start", Some(&arm.start)),
+        ("target_joints", arm.target_joints.as_ref()),
+    ] {
+        let Some(q) = q else { continue };
+        if q.len() != n {
+            bad(
+                key(name),
+                format!("expected {n} joint angles (one per link), got {}", q.len()),
+            );
+            ok = false;
+            continue;
+        }
+        for (l, (angle, link)) in q.iter().zip(&arm.links).enumerate() {
+            if !angle.is_finite() {
+                bad(
+                    key(name),
+                    format!("joint {l}: must be a finite angle, got {angle}"),
+                );
+                ok = false;
+            } else if let Some([lo, hi]) = link.limits
+                && !(lo..=hi).contains(angle)
+            {
+                bad(
+                    key(name),
+                    format!("joint {l}: {angle} rad is outside its limits [{lo}, {hi}]"),
+                );
+                ok = false;
+            }
+        }
+    }
+    match (&arm.target_joints, arm.target_point) {
+        (Some(_), Some(_)) | (None, None) => {
+            bad(
+                key("target_joints"),
+                "give exactly one of target_joints (rad) and target_point (m)".into(),
+            );
+            ok = false;
+        }
+        (None, Some(p)) if ok => {
+            let reach: f64 = arm.links.iter().map(|l| l.length).sum();
+            let d = (p[0] - arm.base[0]).hypot(p[1] - arm.base[1]);
+            if !(p[0].is_finite() && p[1].is_finite()) || d > reach + arm.target_radius {
+                bad(
+                    key("target_point"),
+                    format!(
+                        "[{}, {}] is {d:.3} m from the base, out of the arm's reach ({reach} m)",
+                        p[0], p[1]
+                    ),
+                );
+                ok = false;
+            }
+        }
+        _ => {}
+    }
+    if !(arm.target_radius.is_finite() && arm.target_radius > 0.0) {
+        bad(
+            key("target_radius"),
+            format!(
+                "must be a positive finite number, got {}",
+                arm.target_radius
+            ),
+        );
+        ok = false;
+    }
+    check_controller(bad, &|k| key(&format!("controller.{k}")), &arm.controller);
+    if let Some(e) = &arm.expect
+        && let Err(problems) = crate::expect::bounds_of::<crate::sim::arm_run::ArmSummary>(e)
+    {
+        for (name, message) in problems {
+            bad(key(&format!("expect.{name}")), message);
+        }
+    }
+    if !matches!(
+        arm.controller.kind,
+        ControllerKind::Nadf | ControllerKind::Viscous
+    ) {
+        bad(
+            key("controller.kind"),
+            format!(
+                "`{}` is not available for an arm: use `nadf` or `viscous`",
+                arm.controller.kind.name()
+            ),
+        );
+    }
+    if !ok {
+        return;
+    }
+    // The start clear of the walls and of itself (links not jointed to each other).
+    let chain = arm.chain();
+    let joints = chain.joints(&arm.start);
+    let segments: Vec<[[f64; 2]; 2]> = joints.windows(2).map(|w| [w[0], w[1]]).collect();
+    for (l, s) in segments.iter().enumerate() {
+        let r = chain.links[l].radius;
+        let hit = named_walls(world).find(|(_, wall)| {
+            wall_shape(wall).is_some_and(|w| {
+                let segment = parry2d::shape::Segment::new(
+                    parry2d::math::Vector::new(s[0][0] as f32, s[0][1] as f32),
+                    parry2d::math::Vector::new(s[1][0] as f32, s[1][1] as f32),
+                );
+                parry2d::query::distance(
+                    &parry2d::math::Pose::IDENTITY,
+                    &segment,
+                    &w.pose,
+                    w.shape.as_ref(),
+                )
+                .is_ok_and(|d| f64::from(d.distance) <= r)
+            })
+        });
+        if let Some((wall, _)) = hit {
+            bad(
+                key("start"),
+                format!("link {l} overlaps or touches {wall} at the start"),
+            );
+            return;
+        }
+        for (k, t) in segments.iter().enumerate().take(l.saturating_sub(1)) {
+            if crate::field::segment_distance(*s, *t) <= r + chain.links[k].radius {
+                bad(
+                    key("start"),
+                    format!("links {k} and {l} overlap at the start"),
+                );
+                return;
+            }
+        }
+    }
 }
 
 /// `field.headings` for a shaped agent: even (the solver's periodic red-black colouring), at
