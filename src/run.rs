@@ -101,6 +101,9 @@ pub struct FieldStats {
     pub solve_time: Duration,
     /// For a shaped agent: the heading cells of its (x, y, θ) grid and the time its mask took.
     pub headings: Option<(usize, Duration)>,
+    /// For an arm: its joint-space grid, cells per joint from the base out, and the time its
+    /// mask took (`cells` is then its last joint's and, with three, the second's).
+    pub joints: Option<(Vec<usize>, Duration)>,
 }
 
 /// Simulates `world` to its duration.
@@ -140,6 +143,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
                 relative_residual: field.relative_residual,
                 solve_time: field.solve_time,
                 headings: None,
+                joints: None,
             })
         })
         .chain(sim.arms.iter().map(|a| FieldStats {
@@ -149,7 +153,11 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
             solves: a.field.solves,
             relative_residual: a.field.relative_residual,
             solve_time: a.field.solve_time,
-            headings: Some((a.field.lattice.dims.nt, a.mask_time)),
+            headings: None,
+            joints: Some((
+                a.field.mask.axes.iter().map(|x| x.cells).collect(),
+                a.mask_time,
+            )),
         }))
         .chain(sim.shaped.iter().map(|s| FieldStats {
             agent: s.agent.name.clone(),
@@ -159,6 +167,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
             relative_residual: s.field.relative_residual,
             solve_time: s.field.solve_time,
             headings: Some((s.field.mask.headings, s.field.mask_time)),
+            joints: None,
         }))
         .collect();
     let mut recorder = match (&options.recording, &options.viewer) {
@@ -294,18 +303,23 @@ impl Report {
     pub fn table(&self) -> String {
         let mut out = String::new();
         for f in &self.fields {
-            let (headings, mask) = match f.headings {
-                Some((n, t)) => (
-                    format!(" x {n} headings"),
-                    format!(", mask {:.0} ms", t.as_secs_f64() * 1e3),
+            let mask = |t: &Duration| format!(", mask {:.0} ms", t.as_secs_f64() * 1e3);
+            let grid = match (&f.headings, &f.joints) {
+                (Some((n, t)), _) => format!(
+                    "{} x {} cells x {n} headings{}",
+                    f.cells[0],
+                    f.cells[1],
+                    mask(t)
                 ),
-                None => (String::new(), String::new()),
+                (None, Some((cells, t))) => {
+                    let cells: Vec<String> = cells.iter().map(ToString::to_string).collect();
+                    format!("{} joint cells{}", cells.join(" x "), mask(t))
+                }
+                (None, None) => format!("{} x {} cells", f.cells[0], f.cells[1]),
             };
             out += &format!(
-                "field of {}: {} x {} cells{headings}{mask}, {} solve(s), {} iterations, relative residual {:.1e}, {:.0} ms\n",
+                "field of {}: {grid}, {} solve(s), {} iterations, relative residual {:.1e}, {:.0} ms\n",
                 f.agent,
-                f.cells[0],
-                f.cells[1],
                 f.solves,
                 f.iterations,
                 f.relative_residual,

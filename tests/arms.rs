@@ -21,8 +21,32 @@ fn a_two_link_arm_reaches_round_a_post() {
         "{arm:?}"
     );
     assert!(arm.settling_time.is_some_and(|t| t < 5.0), "{arm:?}");
-    assert_eq!(report.fields[0].cells, [256, 1]);
+    assert_eq!(
+        report.fields[0].joints.as_ref().map(|j| j.0.clone()),
+        Some(vec![256, 256])
+    );
     assert!(report.to_json().contains("\"arms\""));
+}
+
+/// The three-link arm reaches into the shelf, its last links level in the slot, touching
+/// nothing (a 128³ joint space).
+#[test]
+fn a_three_link_arm_reaches_into_a_shelf() {
+    let report = run(
+        &common::world("arm-shelf.toml", &[]),
+        &RunOptions::default(),
+    )
+    .unwrap();
+    let arm = &report.arms[0];
+    assert!(arm.reached && arm.contacts == 0, "{arm:?}");
+    assert!(
+        arm.final_tip_error < 0.06 && arm.min_clearance > 0.0,
+        "{arm:?}"
+    );
+    assert_eq!(
+        report.fields[0].joints.as_ref().map(|j| j.0.clone()),
+        Some(vec![128; 3])
+    );
 }
 
 /// A point the arm could reach in free space but not among the walls (a closed box around it)

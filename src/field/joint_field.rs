@@ -66,7 +66,7 @@ impl JointField {
     /// Solves the field of `chain` on `mask` towards `target`, from the configuration `start`
     /// (rad); `name` names the arm in errors.
     ///
-    /// Errors: no free cell in the target set ([`FieldError::TargetBlocked`]), a start not
+    /// Errors: no free cell in the target set ([`FieldError::ArmTargetBlocked`]), a start not
     /// connected to it ([`FieldError::PoseUnreachable`]), a solve that missed `tolerance`.
     pub fn solve(
         chain: &Chain,
@@ -127,9 +127,10 @@ impl JointField {
             .filter(|&c| !mask.blocked[c] && in_target(&centre(c)))
             .collect();
         if target_cells.is_empty() {
-            return Err(FieldError::TargetBlocked {
-                agent: name.to_string(),
-                cell: step0,
+            return Err(FieldError::ArmTargetBlocked {
+                arm: name.to_string(),
+                cells: mask.axes[0].cells,
+                margin: mask.margins.last().copied().unwrap_or(0.0),
             });
         }
         let mut reachable = vec![false; dims.len()];

@@ -92,6 +92,18 @@ pub enum FieldError {
         /// The agent's radius, m.
         radius: f64,
     },
+    /// No configuration of an arm's target set is free on its joint-space grid.
+    #[error(
+        "arm `{arm}`: no configuration of its target set is free on its joint-space grid ({cells} cells per joint, each cell blocked when a link comes within {margin:.3} m of a wall anywhere in it); move the target away from the walls, or use more cells"
+    )]
+    ArmTargetBlocked {
+        /// The arm's name.
+        arm: String,
+        /// Cells per joint (the first joint's).
+        cells: usize,
+        /// The last link's margin over a cell, m.
+        margin: f64,
+    },
     /// No sequence of free poses connects a shaped agent's start pose to its target.
     #[error(
         "agent `{agent}`: no sequence of poses of its shape connects its start (at its heading) to its target on the (x, y, θ) grid: the task is intractable (a wider passage, a smaller shape, or a finer field.cell or more field.headings may make it tractable)"
