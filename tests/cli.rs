@@ -844,3 +844,40 @@ fn a_shaped_agents_run_is_recorded_and_its_field_exported() {
     assert!(target > 0 && inside > 100_000, "{target} {inside}");
     assert!(dir.path().join("couch.png").is_file());
 }
+
+/// An arm's run (issue 27) is recorded: its links per step, its tip's trail, its joint-space
+/// field and path (two links), and its joint angles and torques.
+#[test]
+fn an_arms_run_is_recorded_with_its_joint_space() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("arm-post.toml");
+    let out = nadf(
+        dir.path(),
+        &[
+            "run",
+            world.to_str().unwrap(),
+            "--set",
+            "duration=1",
+            "--set",
+            "arms.0.expect.reached=false",
+            "-o",
+            "arm.rrd",
+        ],
+    );
+    common::assert_success(&out);
+    let recording = Recording::read(&dir.path().join("arm.rrd"));
+    recording.assert_has(&[
+        "world/arms/arm/links",
+        "world/arms/arm/trail",
+        "world/arms/arm/target",
+        "joint_space/arm/field",
+        "joint_space/arm/path",
+        "plots/arm/joints[q1 (rad)]",
+        "plots/arm/torques[τ2 (N·m)]",
+    ]);
+    // One second at 2 ms: the links at every step.
+    assert_eq!(
+        recording.rows("world/arms/arm/links", "LineStrips2D:strips"),
+        500
+    );
+}

@@ -15,7 +15,57 @@ const TRAIL_EVERY: usize = 25;
 #[derive(Default)]
 pub struct ArmSteps {
     trails: Vec<Vec<[f32; 2]>>,
+    /// Each two-link arm's joint angles since the last segment of its joint-space path.
+    paths: Vec<Vec<[f32; 2]>>,
     steps: usize,
+}
+
+/// A two-link arm's joint-space field as an image: pixel `(k₁, k₂)` is the cell of joint
+/// cells `k₁, k₂`, placed so that image coordinates are radians (`q₁` right, `q₂` down).
+fn log_joint_field(
+    rec: &RecordingStream,
+    arm: &ArmRun,
+    root: &str,
+) -> Result<(), rerun::RecordingStreamError> {
+    let field = &arm.field;
+    let (a1, a2) = (field.mask.axes[0], field.mask.axes[1]);
+    let deepest = (0..field.w.len())
+        .filter(|&c| field.reachable[c])
+        .map(|c| field.w.log10(c))
+        .filter(|l| l.is_finite())
+        .fold(0.0, f64::min);
+    let mut rgb = Vec::with_capacity(a1.cells * a2.cells * 3);
+    for k2 in 0..a2.cells {
+        for k1 in 0..a1.cells {
+            let c = field.mask.index(&[k1, k2]);
+            let colour = if field.mask.blocked[c] {
+                palette::BLOCKED
+            } else if !field.reachable[c] {
+                palette::UNREACHABLE
+            } else {
+                let l = field.w.log10(c);
+                super::colormap::viridis(if deepest < 0.0 {
+                    1.0 - l / deepest
+                } else {
+                    1.0
+                })
+            };
+            rgb.extend_from_slice(&colour);
+        }
+    }
+    let field_path = format!("{root}/field");
+    let lo = |a: &crate::field::JointAxis| (a.center(0) - 0.5 * a.step()) as f32;
+    rec.log_static(
+        field_path.as_str(),
+        &rerun::Transform3D::from_translation_scale(
+            [lo(&a1), lo(&a2), 0.0],
+            rerun::Scale3D::from([a1.step() as f32, a2.step() as f32, 1.0]),
+        ),
+    )?;
+    rec.log_static(
+        field_path.as_str(),
+        &rerun::Image::from_rgb24(rgb, [a1.cells as u32, a2.cells as u32]).with_draw_order(-10.0),
+    )
 }
 
 /// Logs each arm's base, its target and its plots' labels (static).
@@ -57,6 +107,10 @@ pub fn log_setup(
         steps
             .trails
             .push(vec![f32x2(arm.chain.tip(&settings.start))]);
+        steps.paths.push(Vec::new());
+        if arm.chain.links.len() == 2 {
+            log_joint_field(rec, arm, &paths.joint_space)?;
+        }
     }
     Ok(steps)
 }
@@ -95,6 +149,28 @@ impl ArmSteps {
                     .with_colors([palette::rerun(colour)]),
             )?;
             self.trails[n].push(f32x2(*s.joints.last().expect("a tip")));
+            if arm.chain.links.len() == 2 {
+                // The angles on the field's axes (a free joint wraps into [−π, π)).
+                let onto = |a: &crate::field::JointAxis, q: f64| {
+                    if a.periodic() {
+                        (q + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                            - std::f64::consts::PI
+                    } else {
+                        q
+                    }
+                };
+                let axes = &arm.field.mask.axes;
+                self.paths[n].push([onto(&axes[0], s.q[0]) as f32, onto(&axes[1], s.q[1]) as f32]);
+                if self.steps.is_multiple_of(TRAIL_EVERY) || last {
+                    let points = std::mem::take(&mut self.paths[n]);
+                    rec.log(
+                        format!("{}/path", paths.joint_space),
+                        &rerun::Points2D::new(points)
+                            .with_colors([palette::rerun(palette::BODY)])
+                            .with_radii([palette::size::points(palette::size::PATH)]),
+                    )?;
+                }
+            }
             if self.steps.is_multiple_of(TRAIL_EVERY) || last {
                 let segment = std::mem::take(&mut self.trails[n]);
                 self.trails[n].push(*segment.last().expect("one point"));

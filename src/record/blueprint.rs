@@ -174,13 +174,35 @@ fn layout(world: &World) -> (Blueprint, Settings) {
             settings.up_to_cursor(view, &format!("/{}", ArmPaths::of(&arm.name).trail));
         }
     }
-    let left: ContainerLike = if spatial_views.len() == 1 {
+    // A two-link arm's joint space, with its field and its path, under the world.
+    let joint_views: Vec<ContainerLike> = (world.arms.iter())
+        .filter(|a| a.links.len() == 2)
+        .map(|a| {
+            let origin = format!("/{}", ArmPaths::of(&a.name).joint_space);
+            let view: ContainerLike =
+                Spatial2DView::new(format!("{}: joint space (q₁ →, q₂ ↓)", a.name))
+                    .with_origin(origin.clone())
+                    .with_contents([format!("+ {origin}/**")])
+                    .into();
+            settings.up_to_cursor(&view, &format!("{origin}/path"));
+            view
+        })
+        .collect();
+    let mut left: ContainerLike = if spatial_views.len() == 1 {
         spatial_views.remove(0)
     } else {
         Vertical::new(spatial_views)
             .with_row_shares([world_share, 1.0 - world_share])
             .into()
     };
+    if !joint_views.is_empty() {
+        let n = joint_views.len() as f32;
+        let mut column = vec![left];
+        column.extend(joint_views);
+        let mut shares = vec![1.0];
+        shares.extend(std::iter::repeat_n(0.8 / n, column.len() - 1));
+        left = Vertical::new(column).with_row_shares(shares).into();
+    }
     let mut views = plot_views(AGENT_PLOTS, &world.agents, |a| a.name.as_str());
     views.extend(plot_views(SHAPED_PLOTS, &world.shaped, |a| a.name.as_str()));
     views.extend(plot_views(ARM_PLOTS, &world.arms, |a| a.name.as_str()));

@@ -147,6 +147,9 @@ pub struct ArmPaths {
     pub target: String,
     /// Contacts (WARN).
     pub events: String,
+    /// The root of its joint space (two links): `…/field` (`log10(1 − V)` as an image, one
+    /// pixel per cell, placed in radians) and `…/path` (its joint angles so far).
+    pub joint_space: String,
 }
 
 impl ArmPaths {
@@ -159,6 +162,7 @@ impl ArmPaths {
             base: path("base"),
             target: path("target"),
             events: path("events"),
+            joint_space: format!("joint_space/{name}"),
         }
     }
 }
