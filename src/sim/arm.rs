@@ -199,16 +199,17 @@ pub enum Aim<'a> {
 /// One control step of an arm at joint angles `q` and velocities `qdot` (rad, rad/s) towards
 /// `aim`:
 /// the plane's `controller` (for a body of mass 1) in the coordinates where `D(q)` is the
-/// identity (see the module), the guidance from `field`. Returns the joint torques, N·m.
+/// identity (see the module), the guidance from `field`. Returns the joint torques, N·m, and
+/// whether the controller's bias was updated (a settling instant).
 pub fn joint_control<const N: usize>(
     (controller, field, chain): (&mut Controller<N>, &JointField, &Chain),
     (q, qdot): (&[f64], &[f64]),
     aim: Aim,
     (dt, touching): (f64, bool),
-) -> Vec<f64> {
+) -> (Vec<f64>, bool) {
     let d = chain.mass_matrix(q);
     let Some(cholesky) = d.cholesky() else {
-        return vec![0.0; N];
+        return (vec![0.0; N], false);
     };
     let l = cholesky.l();
     let lt = l.transpose();
@@ -235,9 +236,9 @@ pub fn joint_control<const N: usize>(
         touching,
         reference_velocity: None,
     };
-    let f = controller.step(&input).force;
-    let tau = l * DVector::from_iterator(N, f.iter().copied());
-    tau.iter().copied().collect()
+    let out = controller.step(&input);
+    let tau = l * DVector::from_iterator(N, out.force.iter().copied());
+    (tau.iter().copied().collect(), out.bias_updated)
 }
 
 #[cfg(test)]
@@ -354,7 +355,7 @@ mod tests {
         let (mut worst, mut checked, mut closest) = (0.0_f64, 0, f64::INFINITY);
         for _ in 0..10_000 {
             let (q, v) = (arm.angles(&physics), arm.velocities(&physics));
-            let tau = joint_control(
+            let (tau, _) = joint_control(
                 (&mut controller, &field, &c),
                 (&q, &v),
                 Aim::Joints(&goal),

@@ -43,6 +43,11 @@ pub struct ArmRun {
     peak_torque: f64,
     control_variation: f64,
     entered_at: Option<f64>,
+    /// The time at the start of the current step, s.
+    time: f64,
+    /// Each update of the bias β: when (s) and the joint error `q − q_T` then (rad; empty for a
+    /// target point).
+    pub bias_updates: Vec<(f64, Vec<f64>)>,
 }
 
 /// An arm's state after a step.
@@ -84,6 +89,8 @@ crate::measured! {
         pub peak_torque: f64 [unit("N·m"), digits(2), column("peak_Nm")],
         /// `Σ_k |τ_k − τ_{k−1}|` over the steps, N·m.
         pub control_variation: f64 [unit("N·m"), digits(2), column("var_Nm")],
+        /// Updates of the iterative bias β (eq. 49); zero without the bias option.
+        pub bias_updates: usize [column("updates")],
     }
 }
 
@@ -155,6 +162,8 @@ impl ArmRun {
             peak_torque: 0.0,
             control_variation: 0.0,
             entered_at: None,
+            time: 0.0,
+            bias_updates: Vec::new(),
         };
         run.state.in_target = run.in_target(&run.settings.start.clone());
         if run.state.in_target {
@@ -197,8 +206,8 @@ impl ArmRun {
             (None, None) => unreachable!("validated: one target"),
         };
         let touching = !self.touching.is_empty();
-        let tau = if !finite {
-            vec![0.0; q.len()]
+        let (tau, bias_updated) = if !finite {
+            (vec![0.0; q.len()], false)
         } else {
             match &mut self.controller {
                 ArmController::Two(c) => joint_control(
@@ -219,6 +228,15 @@ impl ArmRun {
             .into_iter()
             .map(|t| if (t as f32).is_finite() { t } else { 0.0 })
             .collect();
+        if bias_updated {
+            let error = match &self.settings.target_joints {
+                Some(t) => (q.iter().zip(t))
+                    .map(|(a, b)| angle_difference(*a, *b))
+                    .collect(),
+                None => Vec::new(),
+            };
+            self.bias_updates.push((self.time, error));
+        }
         self.bodies.apply_torques(physics, &tau);
         let size = tau.iter().fold(0.0f64, |m, t| m.max(t.abs()));
         self.peak_torque = self.peak_torque.max(size);
@@ -289,6 +307,7 @@ impl ArmRun {
                 }
             }
         }
+        self.time = time;
         let in_target = self.in_target(&q);
         if in_target && !self.state.in_target {
             self.entered_at = Some(time);
@@ -327,6 +346,7 @@ impl ArmRun {
             },
             peak_torque: self.peak_torque,
             control_variation: self.control_variation,
+            bias_updates: self.bias_updates.len(),
         }
     }
 }
