@@ -3,18 +3,17 @@
 
 use rerun::RecordingStream;
 
-use super::names::{ARM_PLOTS, ArmPaths, SIM_TIME, plot};
+use super::names::{
+    ARM_PLOTS, ArmPaths, SIM_TIME, TRAIL_EVERY, Trail, log_plot_labels, log_plot_rows,
+};
 use super::palette;
 use super::world::f32x2;
 use crate::sim::arm_run::ArmRun;
 
-/// Steps between two segments of a tip's trail.
-const TRAIL_EVERY: usize = 25;
-
 /// What the step logging keeps: each arm's trail since its last segment.
 #[derive(Default)]
 pub struct ArmSteps {
-    trails: Vec<Vec<[f32; 2]>>,
+    trails: Vec<Trail>,
     /// Each two-link arm's joint angles since the last segment of its joint-space path.
     paths: Vec<Vec<[f32; 2]>>,
     steps: usize,
@@ -101,12 +100,10 @@ pub fn log_setup(
                 .with_colors([palette::rerun(palette::TARGET)])
                 .with_radii([0.01]),
         )?;
-        for p in ARM_PLOTS {
-            rec.log_static(plot(&settings.name, p.key), &p.lines(settings))?;
-        }
+        log_plot_labels(rec, ARM_PLOTS, &settings.name, settings)?;
         steps
             .trails
-            .push(vec![f32x2(arm.chain.tip(&settings.start))]);
+            .push(Trail::from(f32x2(arm.chain.tip(&settings.start))));
         steps.paths.push(Vec::new());
         if arm.chain.links.len() == 2 {
             log_joint_field(rec, arm, &paths.joint_space)?;
@@ -148,7 +145,16 @@ impl ArmSteps {
                     .with_radii(radii)
                     .with_colors([palette::rerun(colour)]),
             )?;
-            self.trails[n].push(f32x2(*s.joints.last().expect("a tip")));
+            let due = self.steps.is_multiple_of(TRAIL_EVERY) || last;
+            if let Some(segment) = self.trails[n].push(f32x2(*s.joints.last().expect("a tip")), due)
+            {
+                rec.log(
+                    paths.trail.as_str(),
+                    &rerun::LineStrips2D::new([segment])
+                        .with_colors([palette::rerun(palette::KINEMATIC)])
+                        .with_radii([0.008]),
+                )?;
+            }
             if arm.chain.links.len() == 2 {
                 // The angles on the field's axes (a free joint wraps into [−π, π)).
                 let onto = |a: &crate::field::JointAxis, q: f64| {
@@ -171,31 +177,13 @@ impl ArmSteps {
                     )?;
                 }
             }
-            if self.steps.is_multiple_of(TRAIL_EVERY) || last {
-                let segment = std::mem::take(&mut self.trails[n]);
-                self.trails[n].push(*segment.last().expect("one point"));
-                rec.log(
-                    paths.trail.as_str(),
-                    &rerun::LineStrips2D::new([segment])
-                        .with_colors([palette::rerun(palette::KINEMATIC)])
-                        .with_radii([0.008]),
-                )?;
-            }
             for event in &s.events {
                 rec.log(
                     paths.events.as_str(),
                     &rerun::TextLog::new(event.as_str()).with_level(rerun::TextLogLevel::WARN),
                 )?;
             }
-            for p in ARM_PLOTS {
-                rec.log(
-                    plot(&arm.settings.name, p.key),
-                    &rerun::Scalars::new(
-                        p.series_of(&arm.settings)
-                            .map(|x| (x.value)(&arm.settings, s)),
-                    ),
-                )?;
-            }
+            log_plot_rows(rec, ARM_PLOTS, &arm.settings.name, (&arm.settings, s))?;
         }
         Ok(())
     }

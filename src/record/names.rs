@@ -281,6 +281,66 @@ impl<Owner, State> Plot<Owner, State> {
     }
 }
 
+/// Logs the labels of every plot of `table` that `owner` (called `name`) has (static).
+pub fn log_plot_labels<Owner, State>(
+    rec: &rerun::RecordingStream,
+    table: &[Plot<Owner, State>],
+    name: &str,
+    owner: &Owner,
+) -> Result<(), rerun::RecordingStreamError> {
+    for p in table {
+        rec.log_static(plot(name, p.key), &p.lines(owner))?;
+    }
+    Ok(())
+}
+
+/// Logs one row of every plot of `table` for `owner` (called `name`) in `state`, at the
+/// stream's current time.
+pub fn log_plot_rows<Owner, State>(
+    rec: &rerun::RecordingStream,
+    table: &[Plot<Owner, State>],
+    name: &str,
+    (owner, state): (&Owner, &State),
+) -> Result<(), rerun::RecordingStreamError> {
+    for p in table {
+        rec.log(
+            plot(name, p.key),
+            &rerun::Scalars::new(p.series_of(owner).map(|x| (x.value)(owner, state))),
+        )?;
+    }
+    Ok(())
+}
+
+/// Steps between two segments of a shape's or an arm's trail.
+pub const TRAIL_EVERY: usize = 25;
+
+/// A path logged a segment at a time (the layout shows every segment up to the time cursor):
+/// the points since the last segment, the last of which starts the next.
+#[derive(Debug, Clone, Default)]
+pub struct Trail {
+    points: Vec<[f32; 2]>,
+}
+
+impl Trail {
+    /// A trail from `start`.
+    pub fn from(start: [f32; 2]) -> Self {
+        Self {
+            points: vec![start],
+        }
+    }
+
+    /// Adds `point`; when `due`, returns the segment to log (and keeps its last point).
+    pub fn push(&mut self, point: [f32; 2], due: bool) -> Option<Vec<[f32; 2]>> {
+        self.points.push(point);
+        if !due {
+            return None;
+        }
+        let segment = std::mem::take(&mut self.points);
+        self.points.push(*segment.last().expect("a point"));
+        Some(segment)
+    }
+}
+
 /// One series of a plot: its label, whether an owner has it, and its value after a step.
 pub struct Series<Owner, State> {
     /// Its label in the viewer.

@@ -3,7 +3,7 @@
 
 use rerun::RecordingStream;
 
-use super::names::{PENDULUM_PLOTS, PendulumPaths, SIM_TIME, plot};
+use super::names::{PENDULUM_PLOTS, PendulumPaths, SIM_TIME, log_plot_labels, log_plot_rows};
 use super::palette;
 use super::world::f32x2;
 use crate::sim::pendulum::PendulumRun;
@@ -32,9 +32,7 @@ pub fn log_setup(
             .with_colors([palette::rerun(palette::TARGET)])
             .with_radii([0.01]),
         )?;
-        for p in PENDULUM_PLOTS {
-            rec.log_static(plot(&pendulum.name, p.key), &p.lines(pendulum))?;
-        }
+        log_plot_labels(rec, PENDULUM_PLOTS, &pendulum.name, pendulum)?;
     }
     Ok(())
 }
@@ -63,12 +61,7 @@ pub fn log_step(
                 .with_radii([0.08])
                 .with_colors([palette::rerun(palette::BODY)]),
         )?;
-        for p in PENDULUM_PLOTS {
-            rec.log(
-                plot(&pendulum.name, p.key),
-                &rerun::Scalars::new(p.series_of(pendulum).map(|x| (x.value)(pendulum, s))),
-            )?;
-        }
+        log_plot_rows(rec, PENDULUM_PLOTS, &pendulum.name, (pendulum, s))?;
         if let Some(note) = &s.note {
             rec.log(
                 paths.events,

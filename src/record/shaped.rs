@@ -7,15 +7,15 @@
 use rerun::RecordingStream;
 
 use super::colormap;
-use super::names::{SHAPED_PLOTS, SIM_TIME, ShapedPaths, plot};
+use super::names::{
+    SHAPED_PLOTS, SIM_TIME, ShapedPaths, TRAIL_EVERY, Trail, log_plot_labels, log_plot_rows,
+};
 use super::palette;
 use super::world::f32x2;
 use crate::sim::Simulation;
 use crate::sim::shaped::ShapedRun;
 use crate::world::BodyShape;
 
-/// Steps between two segments of a trail.
-const TRAIL_EVERY: usize = 25;
 /// Distance along the kinematic path between two of its heading marks, m.
 const MARK_EVERY: f64 = 0.5;
 
@@ -26,8 +26,8 @@ pub struct ShapedSteps {
     slices: Vec<Option<usize>>,
     /// The deepest `log10(1 − V)` of each field (the colour scale of its slices).
     deepest: Vec<f64>,
-    /// The trail's points since its last segment, per agent.
-    trails: Vec<Vec<[f32; 2]>>,
+    /// The trail of each agent.
+    trails: Vec<Trail>,
     /// Whether each agent's contacts were drawn at the last step (to clear them once).
     touching: Vec<bool>,
     steps: usize,
@@ -111,12 +111,10 @@ pub fn log_setup(
                 .with_colors([palette::rerun(palette::BODY)])
                 .with_radii([0.015]),
         )?;
-        for p in SHAPED_PLOTS {
-            rec.log_static(plot(&agent.name, p.key), &p.lines(agent))?;
-        }
+        log_plot_labels(rec, SHAPED_PLOTS, &agent.name, agent)?;
         steps.slices.push(None);
         steps.deepest.push(colormap::deepest(&run.field));
-        steps.trails.push(vec![f32x2(agent.start)]);
+        steps.trails.push(Trail::from(f32x2(agent.start)));
         steps.touching.push(false);
     }
     Ok(steps)
@@ -169,10 +167,8 @@ impl ShapedSteps {
                     &rerun::Image::from_rgb24(image, size).with_draw_order(-10.0),
                 )?;
             }
-            self.trails[n].push(f32x2([x, y]));
-            if self.steps.is_multiple_of(TRAIL_EVERY) || last {
-                let segment = std::mem::take(&mut self.trails[n]);
-                self.trails[n].push(*segment.last().expect("one point"));
+            let due = self.steps.is_multiple_of(TRAIL_EVERY) || last;
+            if let Some(segment) = self.trails[n].push(f32x2([x, y]), due) {
                 rec.log(
                     paths.trail.as_str(),
                     &rerun::LineStrips2D::new([segment])
@@ -198,12 +194,7 @@ impl ShapedSteps {
                     &rerun::TextLog::new(event.as_str()).with_level(rerun::TextLogLevel::WARN),
                 )?;
             }
-            for p in SHAPED_PLOTS {
-                rec.log(
-                    plot(&run.agent.name, p.key),
-                    &rerun::Scalars::new(p.series_of(&run.agent).map(|x| (x.value)(&run.agent, s))),
-                )?;
-            }
+            log_plot_rows(rec, SHAPED_PLOTS, &run.agent.name, (&run.agent, s))?;
         }
         Ok(())
     }
