@@ -3,11 +3,8 @@
 
 mod common;
 
-use std::path::Path;
-
 use nadf::run::{RunOptions, run};
 use nadf::sim::Simulation;
-use nadf::world::{Override, load_str};
 
 /// The two-link arm reaches round the post: its tip ends within the target disc, no link
 /// touches anything, and the recording-free run's summary says so.
@@ -88,13 +85,6 @@ kind = "nadf"
 b = 5.0
 "#;
 
-fn errors(text: &str, overrides: &[&str]) -> String {
-    let overrides: Vec<Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
-    load_str(text, Path::new("w.toml"), &overrides)
-        .unwrap_err()
-        .to_string()
-}
-
 /// Each bad arm is an error at its line, naming what is wrong.
 #[test]
 fn bad_arms_are_located_errors() {
@@ -137,19 +127,19 @@ fn bad_arms_are_located_errors() {
         (&["arms.0.cells=7"], "arms.0.cells", "even"),
     ];
     for (sets, key, what) in cases {
-        let e = errors(ARM, sets);
+        let e = common::load_errors(ARM, sets);
         assert!(e.contains(key) && e.contains(what), "{sets:?}: {e}");
     }
-    let e = errors(&ARM.replace("target_point = [2.5, 3.0]\n", ""), &[]);
+    let e = common::load_errors(&ARM.replace("target_point = [2.5, 3.0]\n", ""), &[]);
     assert!(e.contains("w.toml:") && e.contains("exactly one"), "{e}");
     let one = ARM.replace("[[arms.links]]\nlength = 0.8\nlimits = [-2.0, 2.0]\n", "");
-    let e = errors(&one, &["arms.0.start=[0.0]"]);
+    let e = common::load_errors(&one, &["arms.0.start=[0.0]"]);
     assert!(e.contains("arms.0.links") && e.contains("pendulums"), "{e}");
     // A start over a wall names it.
     let walled = ARM.replace(
         "[[arms]]",
         "[[walls]]\nshape = \"disc\"\ncenter = [2.5, 2.0]\nradius = 0.1\n\n[[arms]]",
     );
-    let e = errors(&walled, &[]);
+    let e = common::load_errors(&walled, &[]);
     assert!(e.contains("arms.0.start") && e.contains("walls.0"), "{e}");
 }

@@ -205,13 +205,6 @@ kind = "nadf"
 b = 5.0
 "#;
 
-fn errors(text: &str, overrides: &[&str]) -> String {
-    let overrides: Vec<Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
-    load_str(text, Path::new("w.toml"), &overrides)
-        .unwrap_err()
-        .to_string()
-}
-
 /// Each bad shape or pose is an error at its line, naming what is wrong.
 #[test]
 fn bad_shapes_and_poses_are_located_errors() {
@@ -263,7 +256,7 @@ fn bad_shapes_and_poses_are_located_errors() {
         ),
     ];
     for (text, at, what) in cases {
-        let e = errors(&text, &[]);
+        let e = common::load_errors(&text, &[]);
         assert!(e.contains(at) && e.contains(what), "{what}: {e}");
     }
     // A start over a wall names the wall.
@@ -271,10 +264,10 @@ fn bad_shapes_and_poses_are_located_errors() {
         "[[agents]]",
         "[[walls]]\nshape = \"disc\"\ncenter = [1.2, 1.2]\nradius = 0.1\n\n[[agents]]",
     );
-    let e = errors(&walled, &[]);
+    let e = common::load_errors(&walled, &[]);
     assert!(e.contains("agents.0.start") && e.contains("walls.0"), "{e}");
     // More (x, y, θ) cells than allowed.
-    let e = errors(SHAPED, &["field.max_cells=100000"]);
+    let e = common::load_errors(SHAPED, &["field.max_cells=100000"]);
     assert!(
         e.contains("field.headings") && e.contains("max_cells"),
         "{e}"
@@ -285,10 +278,10 @@ fn bad_shapes_and_poses_are_located_errors() {
         "points = [[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]]\n",
         "",
     );
-    let e = errors(&disc, &["agents.0.target_heading=1.0"]);
+    let e = common::load_errors(&disc, &["agents.0.target_heading=1.0"]);
     assert!(e.contains("target_heading") && e.contains("disc"), "{e}");
     // What a shaped agent does not have yet.
-    let e = errors(SHAPED, &["agents.0.controller.kind=orca"]);
+    let e = common::load_errors(SHAPED, &["agents.0.controller.kind=orca"]);
     assert!(
         e.contains("agents.0.controller.kind") && e.contains("shaped"),
         "{e}"

@@ -27,6 +27,14 @@ pub fn summary(name: &str, overrides: &[&str]) -> Summary {
     report.agents.into_iter().next().unwrap()
 }
 
+/// The errors loading `text` (as `w.toml`, with `--set`-style overrides) reports, as printed.
+pub fn load_errors(text: &str, overrides: &[&str]) -> String {
+    let overrides: Vec<Override> = overrides.iter().map(|o| o.parse().unwrap()).collect();
+    nadf::world::load_str(text, std::path::Path::new("w.toml"), &overrides)
+        .unwrap_err()
+        .to_string()
+}
+
 /// The path of the built `nadf` binary.
 pub fn nadf_bin() -> PathBuf {
     PathBuf::from(env!("CARGO_BIN_EXE_nadf"))
