@@ -304,6 +304,20 @@ fn check_accepts_every_shipped_world() {
         .output()
         .unwrap();
     common::assert_success(&out);
+    // Each file's line counts its bodies by kind.
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    for (world, bodies) in [
+        ("arm-post.toml", "0 agent(s), 1 arm(s)"),
+        ("pendulum.toml", "0 agent(s), 1 pendulum(s)"),
+        ("couch-door.toml", "1 agent(s), 2 wall(s)"),
+    ] {
+        assert!(
+            stdout
+                .lines()
+                .any(|l| l.contains(world) && l.contains(bodies)),
+            "{world}: {stdout}"
+        );
+    }
 }
 
 #[test]

@@ -35,11 +35,20 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
             intractable.push(e);
         }
         if intractable.is_empty() {
+            // The bodies it holds, by kind (agents, discs or shapes, always).
+            let mut bodies = format!("{} agent(s)", world.agents.len() + world.shaped.len());
+            for (n, kind) in [
+                (world.arms.len(), "arm"),
+                (world.pendulums.len(), "pendulum"),
+            ] {
+                if n > 0 {
+                    bodies += &format!(", {n} {kind}(s)");
+                }
+            }
             println!(
-                "{}: ok ({}, {} agent(s), {} wall(s))",
+                "{}: ok ({}, {bodies}, {} wall(s))",
                 path.display(),
                 world.name(),
-                world.agents.len() + world.shaped.len(),
                 world.walls.len()
             );
             // A lidar agent is not refused (it must find out online), but the user is told.
