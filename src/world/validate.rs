@@ -308,18 +308,7 @@ fn check_arm(
             bad(key(&format!("expect.{name}")), message);
         }
     }
-    if !matches!(
-        arm.controller.kind,
-        ControllerKind::Nadf | ControllerKind::Viscous
-    ) {
-        bad(
-            key("controller.kind"),
-            format!(
-                "`{}` is not available for an arm: use `nadf` or `viscous`",
-                arm.controller.kind.name()
-            ),
-        );
-    }
+    guidance_and_damping_only(bad, &key("controller.kind"), arm.controller.kind, "an arm");
     if !ok {
         return;
     }
@@ -360,6 +349,25 @@ fn check_arm(
                 return;
             }
         }
+    }
+}
+
+/// The laws a body other than a disc takes so far: guidance with NADF or viscous damping (the
+/// sliding mode and ORCA are the plane's); `body` says which, in the message.
+fn guidance_and_damping_only(
+    bad: &mut impl FnMut(String, String),
+    key: &str,
+    kind: ControllerKind,
+    body: &str,
+) {
+    if !matches!(kind, ControllerKind::Nadf | ControllerKind::Viscous) {
+        bad(
+            key.to_string(),
+            format!(
+                "`{}` is not available for {body}: use `nadf` or `viscous`",
+                kind.name()
+            ),
+        );
     }
 }
 
@@ -1030,18 +1038,12 @@ fn check_shaped(
     if let Some(inertia) = agent.inertia {
         positive(bad, &key("inertia"), inertia);
     }
-    if !matches!(
+    guidance_and_damping_only(
+        bad,
+        &key("controller.kind"),
         agent.controller.kind,
-        ControllerKind::Nadf | ControllerKind::Viscous
-    ) {
-        bad(
-            key("controller.kind"),
-            format!(
-                "`{}` is not available for a shaped agent yet: use `nadf` or `viscous`",
-                agent.controller.kind.name()
-            ),
-        );
-    }
+        "a shaped agent yet",
+    );
     if agent.sensor.is_some() {
         bad(
             key("sensor"),
