@@ -895,3 +895,31 @@ fn an_arms_run_is_recorded_with_its_joint_space() {
         500
     );
 }
+
+/// A three-link arm's joint space is recorded as the slice through its first joint's angle,
+/// re-logged as the arm turns into another cell of it (arm-shelf turns its first joint by
+/// about 0.6 rad in its first second: several slices), with the path projected on it.
+#[test]
+fn a_three_link_arms_joint_space_is_the_slice_through_its_first_joint() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("arm-shelf.toml");
+    let out = nadf(
+        dir.path(),
+        &[
+            "run",
+            world.to_str().unwrap(),
+            "--set",
+            "duration=1",
+            "--set",
+            "arms.0.expect.reached=false",
+            "-o",
+            "shelf.rrd",
+        ],
+    );
+    common::assert_success(&out);
+    let recording = Recording::read(&dir.path().join("shelf.rrd"));
+    recording.assert_has(&["joint_space/arm/field", "joint_space/arm/path"]);
+    let slices = recording.rows("joint_space/arm/field", "Image:buffer");
+    println!("{slices} slices");
+    assert!((3..500).contains(&slices), "{slices} slices");
+}

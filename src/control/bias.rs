@@ -26,7 +26,7 @@
 //! Re-measurements that change β by less than [`CONVERGED`] of its size are made but not
 //! counted, so the count says how many updates the iteration needed.
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 use super::ControlInput;
 
@@ -86,6 +86,32 @@ impl<const N: usize> Bias<N> {
     /// Updates of β so far.
     pub fn updates(&self) -> usize {
         self.updates
+    }
+
+    /// Re-expresses β, and what the current window has summed, in new coordinates: `β ← M β`,
+    /// for a controller whose coordinates move with the body. An arm's laws act where its
+    /// inertia is the identity, `y = Lᵀ q` with `D(q) = LLᵀ`, and a force `f` there is the
+    /// torque `L f`; the paper's β is a torque (eq. 48: the control fed to the robot), so as
+    /// `L` changes the bias must keep its torque, `M = L_new⁻¹ L_old`. (Held in the moving
+    /// coordinates instead, it acts as a configuration-dependent torque beside the weight's,
+    /// and eq. 50 is no longer the recursion: measured on an arm under gravity, the error fell
+    /// by 2–3 % per update where eq. 65 gives 80–90 %.) The window's impulse and its starting
+    /// momentum are force-like in the same way and take the same map.
+    ///
+    /// ```
+    /// use nadf::control::Bias;
+    /// use nalgebra::Matrix2;
+    /// let mut bias = Bias::<2>::new(0.1, 0.5, 1.0);
+    /// // Nothing measured yet: β stays zero in any coordinates.
+    /// bias.reexpress(&Matrix2::new(2.0, 0.0, 0.0, 0.5));
+    /// assert_eq!(bias.beta().norm(), 0.0);
+    /// ```
+    pub fn reexpress(&mut self, m: &SMatrix<f64, N, N>) {
+        self.beta = m * self.beta;
+        if let Some(window) = &mut self.window {
+            window.impulse = m * window.impulse;
+            window.start_velocity = m * window.start_velocity;
+        }
     }
 
     /// Watches one step that started at `input` and in which the control `u` (N) was applied;
@@ -240,5 +266,32 @@ mod tests {
         assert!(!bias.observe(&at(0.0), &u));
         assert!(bias.observe(&at(0.0), &u));
         assert!(rest(bias.beta()[0]).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_bias_reexpressed_keeps_its_torque_and_its_window() {
+        // An arm's coordinates where the laws act scale by 1/2 (M = 2 maps the old coordinates'
+        // forces to the new ones'): the same torque is twice the force there.
+        let mut bias = Bias::<1>::new(0.05, 0.3, 1.0);
+        let u = Vector1::new(2.5);
+        bias.observe(&at(1.0), &u);
+        for _ in 0..4 {
+            bias.observe(&at(0.01), &u);
+        }
+        assert!((bias.beta() - u).norm() < 1e-12);
+        // Half-way through the next window the coordinates change; the body is held by the same
+        // torque throughout, so the window must measure it as one force in the new coordinates.
+        bias.observe(&at(0.01), &u);
+        let m = nalgebra::Matrix1::new(2.0);
+        bias.reexpress(&m);
+        assert!((bias.beta() - u * 2.0).norm() < 1e-12);
+        for _ in 0..2 {
+            bias.observe(&at(0.02), &(u * 2.0));
+        }
+        assert!(
+            !bias.observe(&at(0.02), &(u * 2.0)),
+            "no change: not an update"
+        );
+        assert!((bias.beta() - u * 2.0).norm() < 1e-12, "{}", bias.beta());
     }
 }

@@ -52,6 +52,11 @@ pub struct JointField {
     pub reachable: Vec<bool>,
     /// The target set's cells.
     pub target_cells: Vec<usize>,
+    /// The target the field leads to.
+    pub target: JointTarget,
+    /// The arm's inertia at the target joints, `D(q_T)`, kg·m²: the metric of the bowl around
+    /// them (see [`JointField::gradient`]); `None` for a point target.
+    pub bowl_metric: Option<nalgebra::DMatrix<f64>>,
     /// Solves (the first and the nested ones).
     pub solves: usize,
     /// CG iterations over all solves.
@@ -170,6 +175,11 @@ impl JointField {
             w,
             reachable,
             target_cells,
+            target: target.clone(),
+            bowl_metric: match target {
+                JointTarget::Joints { q, .. } => Some(chain.mass_matrix(q)),
+                JointTarget::Point { .. } => None,
+            },
             solves: stats.solves,
             iterations: stats.iterations,
             relative_residual: stats.relative_residual,
@@ -265,7 +275,82 @@ impl JointField {
 
     /// `∇V` at the configuration `q` in joint coordinates (1/rad), by interpolating the
     /// central differences of the reachable corners around it; `None` off the field.
+    ///
+    /// **The bowl of a joints target.** `V = 0` on the ball around the target joints, so the
+    /// sampled gradient vanishes there and a body would be left anywhere on the ball. As for a
+    /// disc's target disc ([`crate::field::HarmonicField::gradient`]), within
+    /// [`JointField::rim`] of the target joints (in radians) the gradient continues as a bowl,
+    /// as large as the field at the rim in that direction and falling linearly to zero at
+    /// `q_T`. A disc's bowl is radial; an arm's is radial in its inertia metric at the target,
+    /// `∇V = |∇V(rim)| · D_T e / (rim |D_T ê|)` with `e = q − q_T` and `D_T = D(q_T)`, so that
+    /// where the laws act (the coordinates `y = Lᵀe` in which `D = LLᵀ` is the identity) it
+    /// points along `y`: the normalized guidance's taper is then the conservative spring
+    /// `−(K/r_c) y`. (Radial in radians it is not conservative there, and NADF, which does not
+    /// damp the motion down the guidance, was measured in a limit cycle of 5 mrad around the
+    /// target under gravity.) The guidance is so an error channel that is on all the way to the
+    /// target, which the iterative bias needs (eq. 48: `u = K_P e + β`; the clamp acts only
+    /// while moving away and cannot be one). A point target's set is a family of
+    /// configurations (every one with the tip on the disc), with no one point to lead to: it
+    /// keeps the flat field, and the clamp holds the arm on it.
+    ///
+    /// ```
+    /// use nadf::field::{JointAxis, JointField, JointMask, JointTarget};
+    /// use nadf::world::{Chain, Link};
+    /// let link = |length: f64| Link { length, mass: 1.0, com: 0.5 * length, radius: 0.05 };
+    /// let chain = Chain { base: [2.0, 2.0], links: vec![link(1.0), link(0.8)] };
+    /// let axis = JointAxis { cells: 64, limits: None };
+    /// let mask = JointMask::build(&chain, &[axis, axis], &[], ([0.0, 0.0], [4.0, 4.0]));
+    /// let target = JointTarget::Joints { q: vec![0.5, 1.0], radius: 0.2 };
+    /// let field = JointField::solve(&chain, mask, (&[-2.0, -1.0], &target), 1e-8, "arm").unwrap();
+    /// // Inside the ball: away from q_T in the metric D(q_T), and half as large half-way in.
+    /// let d = chain.mass_matrix(&[0.5, 1.0]);
+    /// let (near, far) = (field.gradient(&[0.55, 1.0]).unwrap(), field.gradient(&[0.6, 1.0]).unwrap());
+    /// let along = d.column(0) / d.column(0).norm();
+    /// assert!((&far / far.norm() - &along).norm() < 1e-12);
+    /// assert!((&far - &near * 2.0).norm() < 1e-12 * far.norm());
+    /// ```
     pub fn gradient(&self, q: &[f64]) -> Option<DVector<f64>> {
+        if let JointTarget::Joints { q: t, .. } = &self.target {
+            let e = DVector::from_iterator(
+                q.len(),
+                q.iter()
+                    .zip(t)
+                    .map(|(a, b)| super::angle_difference(*a, *b)),
+            );
+            let (d, rim) = (e.norm(), self.rim());
+            if d < rim {
+                if d == 0.0 {
+                    return Some(e);
+                }
+                let edge: Vec<f64> = t.iter().zip(&e).map(|(t, e)| t + e * rim / d).collect();
+                let radial = self.bowl_metric.as_ref().map_or(e.clone(), |m| m * &e);
+                if let Some(g) = self.sampled_gradient(&edge)
+                    && g.norm() > 0.0
+                    && g.norm().is_finite()
+                    && radial.norm() > 0.0
+                {
+                    return Some(&radial * (g.norm() * d / (rim * radial.norm())));
+                }
+            }
+        }
+        self.sampled_gradient(q)
+    }
+
+    /// The radius of the bowl around target joints (see [`JointField::gradient`]), rad: half
+    /// as large again as the target's ball, and at least 1.5 cells beyond it, where the
+    /// interpolation no longer reaches its cells. Zero for a point target.
+    pub fn rim(&self) -> f64 {
+        match &self.target {
+            JointTarget::Joints { radius, .. } => {
+                let cell = (self.mask.axes.iter().map(|a| a.step())).fold(0.0, f64::max);
+                (1.5 * radius).max(radius + 1.5 * cell)
+            }
+            JointTarget::Point { .. } => 0.0,
+        }
+    }
+
+    /// The interpolated gradient of the solved cells at `q` (see [`JointField::gradient`]).
+    fn sampled_gradient(&self, q: &[f64]) -> Option<DVector<f64>> {
         let corners = self.corners(q);
         let e = corners.iter().map(|(_, c, _)| self.w.exponent[*c]).max()?;
         let total: f64 = corners.iter().map(|(_, _, w)| w).sum();

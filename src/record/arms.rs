@@ -1,5 +1,8 @@
 //! The arms: base and target (static), the links as capsules from joint to joint and the tip's
-//! trail per step, contacts as events, and the joint angles and torques plotted.
+//! trail per step, contacts as events, the joint angles and torques plotted, and the joint
+//! space: its field as an image with the arm's path on it (both joints of a two-link arm; for
+//! three links the slice through the first joint's current angle, re-logged as it turns into
+//! another cell, with the path's projection on the last two joints).
 
 use rerun::RecordingStream;
 
@@ -14,29 +17,38 @@ use crate::sim::arm_run::ArmRun;
 #[derive(Default)]
 pub struct ArmSteps {
     trails: Vec<Trail>,
-    /// Each two-link arm's joint angles since the last segment of its joint-space path.
+    /// Each arm's joint-space angles (on its image's axes) since the last segment of its path.
     paths: Vec<Vec<[f32; 2]>>,
+    /// Each three-link arm's slice last logged (the first joint's cell).
+    slices: Vec<Option<usize>>,
+    /// The deepest `log10(1 − V)` of each arm's field (the colour scale of its images).
+    deepest: Vec<f64>,
     steps: usize,
 }
 
-/// A two-link arm's joint-space field as an image: pixel `(k₁, k₂)` is the cell of joint
-/// cells `k₁, k₂`, placed so that image coordinates are radians (`q₁` right, `q₂` down).
-fn log_joint_field(
-    rec: &RecordingStream,
-    arm: &ArmRun,
-    root: &str,
-) -> Result<(), rerun::RecordingStreamError> {
+/// The joints an arm's joint-space image shows: both of two links; the last two of three
+/// (a slice at the first joint's angle).
+fn plane(arm: &ArmRun) -> [usize; 2] {
+    let n = arm.chain.links.len();
+    [n - 2, n - 1]
+}
+
+/// An arm's joint-space field as an image over [`plane`]'s joints, at the first joint's cell
+/// `slice` for three links: pixel `(i, j)` is the cell of those joints' cells `i, j`, placed
+/// (by the static transform of [`log_joint_axes`]) so that image coordinates are radians
+/// (the first of them right, the second down).
+fn joint_image(arm: &ArmRun, slice: usize, deepest: f64) -> (Vec<u8>, [u32; 2]) {
     let field = &arm.field;
-    let (a1, a2) = (field.mask.axes[0], field.mask.axes[1]);
-    let deepest = (0..field.w.len())
-        .filter(|&c| field.reachable[c])
-        .map(|c| field.w.log10(c))
-        .filter(|l| l.is_finite())
-        .fold(0.0, f64::min);
-    let mut rgb = Vec::with_capacity(a1.cells * a2.cells * 3);
-    for k2 in 0..a2.cells {
-        for k1 in 0..a1.cells {
-            let c = field.mask.index(&[k1, k2]);
+    let [a, b] = plane(arm);
+    let (wide, high) = (field.mask.axes[a].cells, field.mask.axes[b].cells);
+    let mut rgb = Vec::with_capacity(wide * high * 3);
+    for j in 0..high {
+        for i in 0..wide {
+            let c = if field.mask.axes.len() == 3 {
+                field.mask.index(&[slice, i, j])
+            } else {
+                field.mask.index(&[i, j])
+            };
             let colour = if field.mask.blocked[c] {
                 palette::BLOCKED
             } else if !field.reachable[c] {
@@ -52,19 +64,34 @@ fn log_joint_field(
             rgb.extend_from_slice(&colour);
         }
     }
-    let field_path = format!("{root}/field");
+    (rgb, [wide as u32, high as u32])
+}
+
+/// The static transform that puts [`joint_image`]'s pixels at their joint angles, rad.
+fn log_joint_axes(
+    rec: &RecordingStream,
+    arm: &ArmRun,
+    root: &str,
+) -> Result<(), rerun::RecordingStreamError> {
+    let [a, b] = plane(arm).map(|k| arm.field.mask.axes[k]);
     let lo = |a: &crate::field::JointAxis| (a.center(0) - 0.5 * a.step()) as f32;
     rec.log_static(
-        field_path.as_str(),
+        format!("{root}/field"),
         &rerun::Transform3D::from_translation_scale(
-            [lo(&a1), lo(&a2), 0.0],
-            rerun::Scale3D::from([a1.step() as f32, a2.step() as f32, 1.0]),
+            [lo(&a), lo(&b), 0.0],
+            rerun::Scale3D::from([a.step() as f32, b.step() as f32, 1.0]),
         ),
-    )?;
-    rec.log_static(
-        field_path.as_str(),
-        &rerun::Image::from_rgb24(rgb, [a1.cells as u32, a2.cells as u32]).with_draw_order(-10.0),
     )
+}
+
+/// The deepest `log10(1 − V)` of an arm's field (0 if it is 1 everywhere).
+fn deepest(arm: &ArmRun) -> f64 {
+    let field = &arm.field;
+    (0..field.w.len())
+        .filter(|&c| field.reachable[c])
+        .map(|c| field.w.log10(c))
+        .filter(|l| l.is_finite())
+        .fold(0.0, f64::min)
 }
 
 /// Logs each arm's base, its target and its plots' labels (static).
@@ -105,8 +132,15 @@ pub fn log_setup(
             .trails
             .push(Trail::from(f32x2(arm.chain.tip(&settings.start))));
         steps.paths.push(Vec::new());
+        steps.slices.push(None);
+        steps.deepest.push(deepest(arm));
+        log_joint_axes(rec, arm, &paths.joint_space)?;
         if arm.chain.links.len() == 2 {
-            log_joint_field(rec, arm, &paths.joint_space)?;
+            let (image, size) = joint_image(arm, 0, *steps.deepest.last().expect("pushed"));
+            rec.log_static(
+                format!("{}/field", paths.joint_space),
+                &rerun::Image::from_rgb24(image, size).with_draw_order(-10.0),
+            )?;
         }
     }
     Ok(steps)
@@ -155,27 +189,40 @@ impl ArmSteps {
                         .with_radii([0.008]),
                 )?;
             }
-            if arm.chain.links.len() == 2 {
-                // The angles on the field's axes (a free joint wraps into [−π, π)).
-                let onto = |a: &crate::field::JointAxis, q: f64| {
-                    if a.periodic() {
-                        (q + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-                            - std::f64::consts::PI
-                    } else {
-                        q
-                    }
-                };
-                let axes = &arm.field.mask.axes;
-                self.paths[n].push([onto(&axes[0], s.q[0]) as f32, onto(&axes[1], s.q[1]) as f32]);
-                if self.steps.is_multiple_of(TRAIL_EVERY) || last {
-                    let points = std::mem::take(&mut self.paths[n]);
-                    rec.log(
-                        format!("{}/path", paths.joint_space),
-                        &rerun::Points2D::new(points)
-                            .with_colors([palette::rerun(palette::BODY)])
-                            .with_radii([palette::size::points(palette::size::PATH)]),
-                    )?;
+            // The angles on the field's axes (a free joint wraps into [−π, π)).
+            let axes = &arm.field.mask.axes;
+            let onto = |k: usize| {
+                let q = s.q[k];
+                if axes[k].periodic() {
+                    (q + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                        - std::f64::consts::PI
+                } else {
+                    q
                 }
+            };
+            if axes.len() == 3
+                && let Some(slice) = axes[0].cell_of(onto(0))
+                && self.slices[n] != Some(slice)
+            {
+                // Three links: the slice through the first joint's current cell, re-logged
+                // when the arm turns into another.
+                self.slices[n] = Some(slice);
+                let (image, size) = joint_image(arm, slice, self.deepest[n]);
+                rec.log(
+                    format!("{}/field", paths.joint_space),
+                    &rerun::Image::from_rgb24(image, size).with_draw_order(-10.0),
+                )?;
+            }
+            let [a, b] = plane(arm);
+            self.paths[n].push([onto(a) as f32, onto(b) as f32]);
+            if self.steps.is_multiple_of(TRAIL_EVERY) || last {
+                let points = std::mem::take(&mut self.paths[n]);
+                rec.log(
+                    format!("{}/path", paths.joint_space),
+                    &rerun::Points2D::new(points)
+                        .with_colors([palette::rerun(palette::BODY)])
+                        .with_radii([palette::size::points(palette::size::PATH)]),
+                )?;
             }
             for event in &s.events {
                 rec.log(

@@ -174,16 +174,20 @@ fn layout(world: &World) -> (Blueprint, Settings) {
             settings.up_to_cursor(view, &format!("/{}", ArmPaths::of(&arm.name).trail));
         }
     }
-    // A two-link arm's joint space, with its field and its path, under the world.
+    // An arm's joint space, with its field and its path, beside the world: both joints of two
+    // links; the last two of three, in the slice through the first joint's angle.
     let joint_views: Vec<ContainerLike> = (world.arms.iter())
-        .filter(|a| a.links.len() == 2)
         .map(|a| {
             let origin = format!("/{}", ArmPaths::of(&a.name).joint_space);
-            let view: ContainerLike =
-                Spatial2DView::new(format!("{}: joint space (q₁ →, q₂ ↓)", a.name))
-                    .with_origin(origin.clone())
-                    .with_contents([format!("+ {origin}/**")])
-                    .into();
+            let title = if a.links.len() == 2 {
+                format!("{}: joint space (q₁ →, q₂ ↓)", a.name)
+            } else {
+                format!("{}: joint space at the current q₁ (q₂ →, q₃ ↓)", a.name)
+            };
+            let view: ContainerLike = Spatial2DView::new(title)
+                .with_origin(origin.clone())
+                .with_contents([format!("+ {origin}/**")])
+                .into();
             settings.up_to_cursor(&view, &format!("{origin}/path"));
             view
         })

@@ -11,8 +11,17 @@
 //! and, with Rapier's dynamics `D q̈ + C q̇ = τ` (Coriolis and centripetal forces left to the
 //! plant, as the paper's controller does), `d/dt (K V + ½ q̇ᵀ D q̇) = −B_d ṽ · M(ṽ, g̃) ≤ 0`:
 //! Proposition 1. Each joint's torque acts on its link and, reversed, on the link before it.
+//!
+//! **Under gravity** (Propositions 3–5) the clamp acts on the offset `Lᵀ(q − q_T)` and the
+//! iterative bias is kept as a torque while `L` changes with `q`
+//! ([`Bias::reexpress`](crate::control::Bias::reexpress)): eq. 48's `β` is the control fed to
+//! the robot. With a joints target the field's bowl is radial in `D(q_T)`
+//! ([`JointField::gradient`]), so the guidance is the spring `K_P = (K/r_c) D(q_T)` down to the
+//! target and each update maps the error by `(K_P + H)⁻¹ H` (eq. 65), `H` the Jacobian of the
+//! weight's torque at the target. Speeds here (`alpha`, `speed_limit`) are `|Lᵀ q̇|`,
+//! `√(q̇ᵀ D q̇)`: √(2 × the kinetic energy), in √J.
 
-use nalgebra::{DMatrix, DVector, SVector};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 use rapier2d::prelude::*;
 
 use crate::control::{ControlInput, Controller};
@@ -199,11 +208,13 @@ pub enum Aim<'a> {
 /// One control step of an arm at joint angles `q` and velocities `qdot` (rad, rad/s) towards
 /// `aim`:
 /// the plane's `controller` (for a body of mass 1) in the coordinates where `D(q)` is the
-/// identity (see the module), the guidance from `field`. Returns the joint torques, N·m, and
+/// identity (see the module), the guidance from `field`. `frame` is the factor `L` of the
+/// last step's `D(q) = LLᵀ` (`None` at the first step), which this step replaces with its own:
+/// the bias is kept as a torque across the change. Returns the joint torques, N·m, and
 /// whether the controller's bias was updated (a settling instant).
 pub fn joint_control<const N: usize>(
     (controller, field, chain): (&mut Controller<N>, &JointField, &Chain),
-    (q, qdot): (&[f64], &[f64]),
+    (q, qdot, frame): (&[f64], &[f64], &mut Option<DMatrix<f64>>),
     aim: Aim,
     (dt, touching): (f64, bool),
 ) -> (Vec<f64>, bool) {
@@ -212,6 +223,13 @@ pub fn joint_control<const N: usize>(
         return (vec![0.0; N], false);
     };
     let l = cholesky.l();
+    // The bias is a torque: it keeps it as the coordinates move (`Bias::reexpress`).
+    if let (Some(bias), Some(previous)) = (&mut controller.bias, frame.as_ref())
+        && let Some(m) = l.solve_lower_triangular(previous)
+    {
+        bias.reexpress(&SMatrix::<f64, N, N>::from_iterator(m.iter().copied()));
+    }
+    *frame = Some(l.clone());
     let lt = l.transpose();
     let v = &lt * DVector::from_column_slice(qdot);
     let gradient = field.gradient(q).and_then(|g| l.solve_lower_triangular(&g));
@@ -294,9 +312,10 @@ mod tests {
     /// Proposition 1 with the arm's own `D(q)`: a three-link arm turning its first joint by
     /// 2.3 rad past a post, without gravity, under the paper's `τ = −K∇V − B_d L M`, simulated by
     /// Rapier's multibody (Coriolis and centripetal terms included), never lets
-    /// `K·V + ½ q̇ᵀ D q̇` grow outside the target set by more than integration error (Rapier's
-    /// f32 step), ends in the target set (the paper's law has no bowl inside it: the body comes
-    /// to rest where NADF stops it), and touches nothing.
+    /// `K·V + ½ q̇ᵀ D q̇` grow outside the target set and its bowl by more than integration
+    /// error (Rapier's f32 step), ends at the target joints (the bowl leads it there; measured
+    /// 1.3e-5 rad after 30 s, having crawled the field's shallow part for 19 s and swung once
+    /// through the target), and touches nothing.
     #[test]
     fn the_energy_of_an_arm_never_increases() {
         let c = chain();
@@ -353,11 +372,11 @@ mod tests {
         let (e0, _) = energy(&physics);
         let mut last = e0;
         let (mut worst, mut checked, mut closest) = (0.0_f64, 0, f64::INFINITY);
-        for _ in 0..10_000 {
+        for _ in 0..15_000 {
             let (q, v) = (arm.angles(&physics), arm.velocities(&physics));
             let (tau, _) = joint_control(
                 (&mut controller, &field, &c),
-                (&q, &v),
+                (&q, &v, &mut None),
                 Aim::Joints(&goal),
                 (dt, false),
             );
@@ -369,10 +388,17 @@ mod tests {
                 let d = crate::field::segment_distance([s[0], s[1]], [[2.1, 3.0], [2.1, 3.0]]);
                 closest = closest.min(d - 0.15 - link.radius);
             }
-            let inside = field
-                .mask
-                .cell_of(&q)
-                .is_some_and(|cell| field.w.value(cell) == 1.0);
+            // In the target set, and in the bowl around it, where the guidance is the
+            // target's spring rather than −K∇V of the solved V (`JointField::gradient`).
+            let to_goal = (q.iter().zip(goal))
+                .map(|(a, b)| angle_difference(*a, b).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let inside = to_goal < field.rim()
+                || field
+                    .mask
+                    .cell_of(&q)
+                    .is_some_and(|cell| field.w.value(cell) == 1.0);
             if !inside {
                 worst = worst.max(e - last);
                 checked += 1;
@@ -395,6 +421,6 @@ mod tests {
             worst <= 1e-3 * e0,
             "the energy rose by {worst} in a step (of {e0})"
         );
-        assert!(error < 0.25, "ended at {q:?}");
+        assert!(error < 1e-3, "ended at {q:?}");
     }
 }

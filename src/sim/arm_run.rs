@@ -36,6 +36,8 @@ pub struct ArmRun {
     /// Wall-clock time of its mask.
     pub mask_time: Duration,
     controller: ArmController,
+    /// The factor `L` of the last control step's `D(q) = LLᵀ` (see [`joint_control`]).
+    frame: Option<nalgebra::DMatrix<f64>>,
     touching: HashSet<ColliderHandle>,
     state: ArmState,
     contacts: usize,
@@ -155,6 +157,7 @@ impl ArmRun {
             bodies,
             mask_time,
             controller,
+            frame: None,
             touching: HashSet::new(),
             state,
             contacts: 0,
@@ -212,13 +215,13 @@ impl ArmRun {
             match &mut self.controller {
                 ArmController::Two(c) => joint_control(
                     (c, &self.field, &self.chain),
-                    (&q, &qdot),
+                    (&q, &qdot, &mut self.frame),
                     aim,
                     (dt, touching),
                 ),
                 ArmController::Three(c) => joint_control(
                     (c, &self.field, &self.chain),
-                    (&q, &qdot),
+                    (&q, &qdot, &mut self.frame),
                     aim,
                     (dt, touching),
                 ),
