@@ -400,6 +400,14 @@ fn an_intractable_task_is_bad_input_naming_the_agent() {
     );
 }
 
+/// An `.npy` file's header and its data's bytes.
+fn read_npy(path: &Path) -> (String, Vec<u8>) {
+    let bytes = std::fs::read(path).unwrap();
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = String::from_utf8(bytes[10..10 + header_len].to_vec()).unwrap();
+    (header, bytes[10 + header_len..].to_vec())
+}
+
 #[test]
 fn field_exports_numpy_arrays_and_a_picture() {
     let dir = tempfile::tempdir().unwrap();
@@ -416,12 +424,7 @@ fn field_exports_numpy_arrays_and_a_picture() {
         "{stdout}"
     );
 
-    let npy = |name: &str| {
-        let bytes = std::fs::read(dir.path().join(name)).unwrap();
-        let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-        let header = String::from_utf8(bytes[10..10 + header_len].to_vec()).unwrap();
-        (header, bytes[10 + header_len..].to_vec())
-    };
+    let npy = |name: &str| read_npy(&dir.path().join(name));
     let (header, v) = npy("room.npy");
     assert!(
         header.contains("'descr': '<f8'") && header.contains("'shape': (201, 201)"),
@@ -453,7 +456,8 @@ fn field_exports_numpy_arrays_and_a_picture() {
     let out = nadf(dir.path(), &["field", world, "--agent", "nobody"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(
-        String::from_utf8_lossy(&out.stderr).contains("no agent `nobody`; the agents are: robot")
+        String::from_utf8_lossy(&out.stderr)
+            .contains("no agent or arm `nobody`; the world has: robot")
     );
 }
 
@@ -830,12 +834,7 @@ fn a_shaped_agents_run_is_recorded_and_its_field_exported() {
         &["field", world, "--npy", "couch.npy", "--png", "couch.png"],
     );
     common::assert_success(&out);
-    let read = |name: &str| {
-        let bytes = std::fs::read(dir.path().join(name)).unwrap();
-        let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-        let header = String::from_utf8(bytes[10..10 + header_len].to_vec()).unwrap();
-        (header, bytes[10 + header_len..].to_vec())
-    };
+    let read = |name: &str| read_npy(&dir.path().join(name));
     let (header, mask) = read("couch.mask.npy");
     assert!(header.contains("'shape': (161, 101, 96)"), "{header}");
     let (_, w) = read("couch.w.npy");
@@ -922,4 +921,56 @@ fn a_three_link_arms_joint_space_is_the_slice_through_its_first_joint() {
     let slices = recording.rows("joint_space/arm/field", "Image:buffer");
     println!("{slices} slices");
     assert!((3..500).contains(&slices), "{slices} slices");
+}
+
+/// `nadf field` on an arm world exports its joint-space field: one axis per joint, `W = 1` on the
+/// target set and in (0, 1) elsewhere on the reachable cells, the post's configurations blocked,
+/// and a picture of the joint space.
+#[test]
+fn field_exports_an_arms_joint_space() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("arm-post.toml");
+    let world = world.to_str().unwrap();
+    let out = nadf(
+        dir.path(),
+        &["field", world, "--npy", "arm.npy", "--png", "arm.png"],
+    );
+    common::assert_success(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("256 x 256 joint cells"), "{stdout}");
+    let (header, mask) = read_npy(&dir.path().join("arm.mask.npy"));
+    assert!(header.contains("'shape': (256, 256)"), "{header}");
+    let (_, w) = read_npy(&dir.path().join("arm.w.npy"));
+    let w: Vec<f64> = (w.chunks(8))
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    let (mut target, mut inside, mut blocked) = (0, 0, 0);
+    for (m, w) in mask.iter().zip(&w) {
+        match m {
+            0 if *w == 1.0 => target += 1,
+            0 => {
+                assert!(*w > 0.0 && *w < 1.0, "{w}");
+                inside += 1;
+            }
+            _ => {
+                assert_eq!(*w, 0.0);
+                blocked += 1;
+            }
+        }
+    }
+    assert!(
+        target > 0 && inside > 50_000 && blocked > 1_000,
+        "{target} {inside} {blocked}"
+    );
+    let png = std::fs::File::open(dir.path().join("arm.png")).unwrap();
+    let reader = png::Decoder::new(std::io::BufReader::new(png))
+        .read_info()
+        .unwrap();
+    assert_eq!((reader.info().width, reader.info().height), (512, 512));
+    let out = nadf(dir.path(), &["field", world, "--agent", "nobody"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr)
+            .contains("no agent or arm `nobody`; the world has: arm")
+    );
 }

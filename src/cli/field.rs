@@ -1,4 +1,4 @@
-//! `nadf field`: solve one agent's harmonic field and export it.
+//! `nadf field`: solve one agent's (or arm's) harmonic field and export it.
 
 use std::path::PathBuf;
 
@@ -13,16 +13,19 @@ use crate::world::{BodyShape, FieldKind, Override};
 pub struct FieldArgs {
     /// The world file (TOML).
     pub world: PathBuf,
-    /// The agent whose field to solve [default: the first].
+    /// The agent or arm whose field to solve [default: the first agent, or the first arm in a
+    /// world without agents].
     #[arg(long)]
     pub agent: Option<String>,
     /// Write V as a float64 array of shape [nx, ny] (x index first; [nx, ny, headings] for a
-    /// shaped agent) to this file, W = 1 - V to FILE.w.npy, log10 W to FILE.log10w.npy and the
-    /// cell mask (0 reachable, 1 blocked, 2 unreachable) to FILE.mask.npy.
+    /// shaped agent; one axis per joint for an arm) to this file, W = 1 - V to FILE.w.npy,
+    /// log10 W to FILE.log10w.npy and the cell mask (0 reachable, 1 blocked, 2 unreachable) to
+    /// FILE.mask.npy.
     #[arg(long, value_name = "FILE.npy")]
     pub npy: Option<PathBuf>,
     /// Write a picture of the field (log10(1 - V), streamlines, start, target; for a shaped
-    /// agent, the slice of its (x, y, θ) field at its start heading).
+    /// agent, the slice of its (x, y, θ) field at its start heading; for an arm its joint space,
+    /// the slice through its first joint's start angle for three links).
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
     /// Override a world value by dotted path (see `run`). Repeatable.
@@ -39,22 +42,36 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         Some(name) => everyone().find(|a| &a.name == name),
         None => everyone().next(),
     };
-    let Some(agent) = agent else {
-        let names: Vec<&str> = everyone().map(|a| a.name.as_str()).collect();
-        return Err(bad_input(
-            path,
-            format!(
-                "no agent `{}`; the agents are: {}",
-                args.agent.as_deref().unwrap_or_default(),
-                names.join(", ")
-            ),
-        ));
+    let arm = match (&args.agent, agent) {
+        (Some(name), None) => world.arms.iter().find(|a| &a.name == name),
+        (None, None) => world.arms.first(),
+        (_, Some(_)) => None,
     };
     let npy = args.npy.as_deref().map(export::npy_paths);
-    let outputs = npy.iter().flatten().chain(&args.png);
-    for out in outputs {
-        output::check_file(out).map_err(|e| bad_input(path, e))?;
+    if agent.is_some() || arm.is_some() {
+        let outputs = npy.iter().flatten().chain(&args.png);
+        for out in outputs {
+            output::check_file(out).map_err(|e| bad_input(path, e))?;
+        }
     }
+    if let Some(arm) = arm {
+        return arm_field(path, &world, arm, npy, args.png.as_deref());
+    }
+    let Some(agent) = agent else {
+        let names: Vec<&str> = (everyone().map(|a| a.name.as_str()))
+            .chain(world.arms.iter().map(|a| a.name.as_str()))
+            .collect();
+        return Err(bad_input(
+            path,
+            match &args.agent {
+                Some(name) => format!(
+                    "no agent or arm `{name}`; the world has: {}",
+                    names.join(", ")
+                ),
+                None => "the world has no agent and no arm: no field to solve".to_string(),
+            },
+        ));
+    };
     if agent.is_shaped() {
         return pose_field(path, &world, agent, npy, args.png.as_deref());
     }
@@ -160,6 +177,71 @@ fn pose_field(
         let row = 3 * w as usize;
         let flipped: Vec<u8> = rgb.chunks(row).rev().flatten().copied().collect();
         files.push((png.to_path_buf(), export::png(&flipped, w, h)));
+    }
+    write_all(path, files)
+}
+
+/// `nadf field` for an arm: its joint-space field, the arrays with one axis per joint, and the
+/// picture of its joint space (for three links, the slice through the first joint's start
+/// angle), the second of the pictured joints up.
+fn arm_field(
+    path: &std::path::Path,
+    world: &crate::world::World,
+    arm: &crate::world::ArmSettings,
+    npy: Option<[PathBuf; 4]>,
+    png: Option<&std::path::Path>,
+) -> Result<(), Failure> {
+    let walls = crate::world::all_wall_shapes(world);
+    let (field, mask_time) =
+        crate::sim::arm_run::solve_field(world, arm, &walls).map_err(|e| bad_input(path, e))?;
+    let cells: Vec<String> = (field.mask.axes.iter())
+        .map(|a| a.cells.to_string())
+        .collect();
+    let reachable = field.reachable.iter().filter(|r| **r).count();
+    let blocked = field.mask.blocked.iter().filter(|b| **b).count();
+    println!(
+        "field of {}: {} joint cells ({reachable} reachable, {blocked} blocked, {} unreachable, {} in the target set)",
+        arm.name,
+        cells.join(" x "),
+        field.reachable.len() - reachable - blocked,
+        field.target_cells.len()
+    );
+    println!(
+        "mask: {:.1} ms; solve: {:.1} ms, {} solve(s), {} CG iterations, relative residual {:.1e}",
+        mask_time.as_secs_f64() * 1e3,
+        field.solve_time.as_secs_f64() * 1e3,
+        field.solves,
+        field.iterations,
+        field.relative_residual
+    );
+    println!(
+        "1 - V at the start: {}",
+        scientific(field.log10_one_minus_potential(&arm.start))
+    );
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    if let Some(paths) = npy {
+        files.extend(paths.into_iter().zip(export::joint_arrays(&field)));
+    }
+    if let Some(png) = png {
+        let slice = field.mask.axes[0].cell_of(arm.start[0]).unwrap_or(0);
+        let deepest = crate::record::joint_deepest(&field);
+        let (rgb, [w, h]) = crate::record::joint_image(&field, slice, deepest);
+        // Row 0 of the image is the second joint's first cell: flipped so that it grows up,
+        // and each cell drawn as a square of pixels, so that the picture is about 512 wide.
+        let scale = (512 / w.max(h)).max(1) as usize;
+        let (wide, high) = (w as usize * scale, h as usize * scale);
+        let mut picture = Vec::with_capacity(wide * high * 3);
+        for y in 0..high {
+            let j = h as usize - 1 - y / scale;
+            for x in 0..wide {
+                let at = 3 * (j * w as usize + x / scale);
+                picture.extend_from_slice(&rgb[at..at + 3]);
+            }
+        }
+        files.push((
+            png.to_path_buf(),
+            export::png(&picture, wide as u32, high as u32),
+        ));
     }
     write_all(path, files)
 }

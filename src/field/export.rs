@@ -3,9 +3,11 @@
 //! Arrays have shape `[nx, ny]`, x index first: element `[i, j]` is cell `(i, j)`, whose centre
 //! is `grid.origin + ((i + ½)·h, (j + ½)·h)`. A shaped agent's field has shape
 //! `[nx, ny, headings]`: element `[i, j, k]` is that cell at the heading `k · 2π / headings`.
+//! An arm's has one axis per joint, `[cells, cells(, cells)]`: element `[k₁, k₂(, k₃)]` is the
+//! cell of those joint cells (see [`super::JointAxis::center`]).
 
 use super::grid::Grid;
-use super::{HarmonicField, PoseField};
+use super::{HarmonicField, JointField, PoseField};
 
 /// The class of a cell in the mask array, stored as its `u8` value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -91,6 +93,68 @@ pub fn pose_arrays(field: &PoseField) -> [Vec<u8>; 4] {
         pose_npy(field, "<f8", 8, |c| value(c).to_le_bytes().to_vec()),
         pose_npy(field, "<f8", 8, |c| log(c).to_le_bytes().to_vec()),
         pose_npy(field, "|u1", 1, |c| vec![class(c) as u8]),
+    ]
+}
+
+/// The four arrays of an arm's joint-space field, as for a disc's: `V`, `W = 1 − V`, `log10 W`
+/// and the mask, each with one axis per joint.
+///
+/// ```
+/// use nadf::field::{JointAxis, JointField, JointMask, JointTarget, export};
+/// use nadf::world::{Chain, Link};
+/// let link = |length: f64| Link { length, mass: 1.0, com: 0.5 * length, radius: 0.05 };
+/// let chain = Chain { base: [2.0, 2.0], links: vec![link(1.0), link(0.8)] };
+/// let axis = JointAxis { cells: 16, limits: None };
+/// let mask = JointMask::build(&chain, &[axis, axis], &[], ([0.0, 0.0], [4.0, 4.0]));
+/// let target = JointTarget::Joints { q: vec![0.5, 1.0], radius: 0.4 };
+/// let field = JointField::solve(&chain, mask, (&[-2.0, -1.0], &target), 1e-8, "arm").unwrap();
+/// let [v, ..] = export::joint_arrays(&field);
+/// assert!(String::from_utf8_lossy(&v[..128]).contains("'shape': (16, 16)"));
+/// ```
+pub fn joint_arrays(field: &JointField) -> [Vec<u8>; 4] {
+    let w = &field.w;
+    let class = |c: usize| {
+        if field.mask.blocked[c] {
+            CellClass::Blocked
+        } else if field.reachable[c] {
+            CellClass::Reachable
+        } else {
+            CellClass::Unreachable
+        }
+    };
+    let value = |c: usize| if field.reachable[c] { w.value(c) } else { 0.0 };
+    let log = |c: usize| {
+        if field.reachable[c] {
+            w.log10(c)
+        } else {
+            f64::NEG_INFINITY
+        }
+    };
+    // The mask's index is C order over the joints' cells, the last joint fastest.
+    let shape: Vec<usize> = field.mask.axes.iter().map(|a| a.cells).collect();
+    let cells = 0..field.mask.blocked.len();
+    [
+        npy_of(
+            &shape,
+            "<f8",
+            8,
+            cells
+                .clone()
+                .map(|c| (1.0 - value(c)).to_le_bytes().to_vec()),
+        ),
+        npy_of(
+            &shape,
+            "<f8",
+            8,
+            cells.clone().map(|c| value(c).to_le_bytes().to_vec()),
+        ),
+        npy_of(
+            &shape,
+            "<f8",
+            8,
+            cells.clone().map(|c| log(c).to_le_bytes().to_vec()),
+        ),
+        npy_of(&shape, "|u1", 1, cells.map(|c| vec![class(c) as u8])),
     ]
 }
 

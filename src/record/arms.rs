@@ -6,6 +6,7 @@
 
 use rerun::RecordingStream;
 
+use super::colormap::{joint_deepest, joint_image, joint_plane};
 use super::names::{
     ARM_PLOTS, ArmPaths, SIM_TIME, TRAIL_EVERY, Trail, log_plot_labels, log_plot_rows,
 };
@@ -26,54 +27,13 @@ pub struct ArmSteps {
     steps: usize,
 }
 
-/// The joints an arm's joint-space image shows: both of two links; the last two of three
-/// (a slice at the first joint's angle).
-fn plane(arm: &ArmRun) -> [usize; 2] {
-    let n = arm.chain.links.len();
-    [n - 2, n - 1]
-}
-
-/// An arm's joint-space field as an image over [`plane`]'s joints, at the first joint's cell
-/// `slice` for three links: pixel `(i, j)` is the cell of those joints' cells `i, j`, placed
-/// (by the static transform of [`log_joint_axes`]) so that image coordinates are radians
-/// (the first of them right, the second down).
-fn joint_image(arm: &ArmRun, slice: usize, deepest: f64) -> (Vec<u8>, [u32; 2]) {
-    let field = &arm.field;
-    let [a, b] = plane(arm);
-    let (wide, high) = (field.mask.axes[a].cells, field.mask.axes[b].cells);
-    let mut rgb = Vec::with_capacity(wide * high * 3);
-    for j in 0..high {
-        for i in 0..wide {
-            let c = if field.mask.axes.len() == 3 {
-                field.mask.index(&[slice, i, j])
-            } else {
-                field.mask.index(&[i, j])
-            };
-            let colour = if field.mask.blocked[c] {
-                palette::BLOCKED
-            } else if !field.reachable[c] {
-                palette::UNREACHABLE
-            } else {
-                let l = field.w.log10(c);
-                super::colormap::viridis(if deepest < 0.0 {
-                    1.0 - l / deepest
-                } else {
-                    1.0
-                })
-            };
-            rgb.extend_from_slice(&colour);
-        }
-    }
-    (rgb, [wide as u32, high as u32])
-}
-
 /// The static transform that puts [`joint_image`]'s pixels at their joint angles, rad.
 fn log_joint_axes(
     rec: &RecordingStream,
     arm: &ArmRun,
     root: &str,
 ) -> Result<(), rerun::RecordingStreamError> {
-    let [a, b] = plane(arm).map(|k| arm.field.mask.axes[k]);
+    let [a, b] = joint_plane(&arm.field).map(|k| arm.field.mask.axes[k]);
     let lo = |a: &crate::field::JointAxis| (a.center(0) - 0.5 * a.step()) as f32;
     rec.log_static(
         format!("{root}/field"),
@@ -82,16 +42,6 @@ fn log_joint_axes(
             rerun::Scale3D::from([a.step() as f32, b.step() as f32, 1.0]),
         ),
     )
-}
-
-/// The deepest `log10(1 − V)` of an arm's field (0 if it is 1 everywhere).
-fn deepest(arm: &ArmRun) -> f64 {
-    let field = &arm.field;
-    (0..field.w.len())
-        .filter(|&c| field.reachable[c])
-        .map(|c| field.w.log10(c))
-        .filter(|l| l.is_finite())
-        .fold(0.0, f64::min)
 }
 
 /// Logs each arm's base, its target and its plots' labels (static).
@@ -133,10 +83,10 @@ pub fn log_setup(
             .push(Trail::from(f32x2(arm.chain.tip(&settings.start))));
         steps.paths.push(Vec::new());
         steps.slices.push(None);
-        steps.deepest.push(deepest(arm));
+        steps.deepest.push(joint_deepest(&arm.field));
         log_joint_axes(rec, arm, &paths.joint_space)?;
         if arm.chain.links.len() == 2 {
-            let (image, size) = joint_image(arm, 0, *steps.deepest.last().expect("pushed"));
+            let (image, size) = joint_image(&arm.field, 0, *steps.deepest.last().expect("pushed"));
             rec.log_static(
                 format!("{}/field", paths.joint_space),
                 &rerun::Image::from_rgb24(image, size).with_draw_order(-10.0),
@@ -207,13 +157,13 @@ impl ArmSteps {
                 // Three links: the slice through the first joint's current cell, re-logged
                 // when the arm turns into another.
                 self.slices[n] = Some(slice);
-                let (image, size) = joint_image(arm, slice, self.deepest[n]);
+                let (image, size) = joint_image(&arm.field, slice, self.deepest[n]);
                 rec.log(
                     format!("{}/field", paths.joint_space),
                     &rerun::Image::from_rgb24(image, size).with_draw_order(-10.0),
                 )?;
             }
-            let [a, b] = plane(arm);
+            let [a, b] = joint_plane(&arm.field);
             self.paths[n].push([onto(a) as f32, onto(b) as f32]);
             if self.steps.is_multiple_of(TRAIL_EVERY) || last {
                 let points = std::mem::take(&mut self.paths[n]);

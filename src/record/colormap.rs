@@ -1,7 +1,8 @@
 //! The potential as a picture: `log10(1 - V)` through a perceptual colour map.
 
 use super::palette::{BLOCKED, UNREACHABLE};
-use crate::field::{HarmonicField, PoseField};
+
+use crate::field::{HarmonicField, JointField, PoseField, ScaledW};
 
 /// The agent's field as RGB bytes, row `j` of the image being grid row `j` (y up in the world;
 /// the recording's transforms put it the right way up), and the image's `[width, height]`.
@@ -66,11 +67,61 @@ pub fn pose_slice_image(field: &PoseField, theta: f64, deepest: f64) -> (Vec<u8>
 
 /// The deepest `log10(1 − V)` of a shaped agent's field (0 if it is 1 everywhere).
 pub fn deepest(field: &PoseField) -> f64 {
-    (0..field.w.len())
-        .filter(|&c| field.reachable[c])
-        .map(|c| field.w.log10(c))
+    deepest_of(&field.w, &field.reachable)
+}
+
+/// The deepest `log10(1 − V)` of an arm's joint-space field (0 if it is 1 everywhere).
+pub fn joint_deepest(field: &JointField) -> f64 {
+    deepest_of(&field.w, &field.reachable)
+}
+
+/// The deepest `log10 W` over the `reachable` cells.
+fn deepest_of(w: &ScaledW, reachable: &[bool]) -> f64 {
+    (0..w.len())
+        .filter(|&c| reachable[c])
+        .map(|c| w.log10(c))
         .filter(|l| l.is_finite())
         .fold(0.0, f64::min)
+}
+
+/// The joints an arm's joint-space picture shows: both of two joints; the last two of three
+/// (a slice at the first joint's angle).
+pub fn joint_plane(field: &JointField) -> [usize; 2] {
+    let n = field.mask.axes.len();
+    [n - 2, n - 1]
+}
+
+/// An arm's joint-space field as RGB bytes over [`joint_plane`]'s joints, at the first
+/// joint's cell `slice` for three joints (ignored for two), and the image's `[width, height]`:
+/// pixel `(i, j)` is the cell of those joints' cells `i, j` (the first of them along the row),
+/// coloured as `potential_image` does, scaled to `deepest` (so that slices compare).
+pub fn joint_image(field: &JointField, slice: usize, deepest: f64) -> (Vec<u8>, [u32; 2]) {
+    let [a, b] = joint_plane(field);
+    let (wide, high) = (field.mask.axes[a].cells, field.mask.axes[b].cells);
+    let mut rgb = Vec::with_capacity(wide * high * 3);
+    for j in 0..high {
+        for i in 0..wide {
+            let c = if field.mask.axes.len() == 3 {
+                field.mask.index(&[slice, i, j])
+            } else {
+                field.mask.index(&[i, j])
+            };
+            let colour = if field.mask.blocked[c] {
+                BLOCKED
+            } else if !field.reachable[c] {
+                UNREACHABLE
+            } else {
+                let l = field.w.log10(c);
+                viridis(if deepest < 0.0 {
+                    1.0 - l / deepest
+                } else {
+                    1.0
+                })
+            };
+            rgb.extend_from_slice(&colour);
+        }
+    }
+    (rgb, [wide as u32, high as u32])
 }
 
 /// The viridis colour map at `t ∈ [0, 1]` (piecewise linear through 9 of its stops).

@@ -65,7 +65,7 @@ mod picture;
 mod shaped;
 mod world;
 
-pub use colormap::{deepest, pose_slice_image};
+pub use colormap::{deepest, joint_deepest, joint_image, joint_plane, pose_slice_image};
 pub use columns::Runs;
 pub use picture::field_picture;
 

@@ -96,6 +96,45 @@ crate::measured! {
     }
 }
 
+/// The joint-space field of `settings` (an arm of `world`) among `walls`, and how long its mask
+/// took: the mask of its links, then the field towards its target (an intractable target is an
+/// error before the solve).
+pub fn solve_field(
+    world: &World,
+    settings: &ArmSettings,
+    walls: &[WallShape],
+) -> Result<(JointField, Duration), FieldError> {
+    let chain = settings.chain();
+    let axes: Vec<JointAxis> = (settings.links.iter())
+        .map(|l| JointAxis {
+            cells: settings.cells(),
+            limits: l.limits,
+        })
+        .collect();
+    let started = Instant::now();
+    let mask = JointMask::build(&chain, &axes, walls, world.bounds());
+    let mask_time = started.elapsed();
+    let target = match (&settings.target_joints, settings.target_point) {
+        (Some(q), _) => JointTarget::Joints {
+            q: q.clone(),
+            radius: settings.target_radius,
+        },
+        (None, Some(point)) => JointTarget::Point {
+            point,
+            radius: settings.target_radius,
+        },
+        (None, None) => unreachable!("validated: one target"),
+    };
+    let field = JointField::solve(
+        &chain,
+        mask,
+        (&settings.start, &target),
+        world.field.tolerance,
+        &settings.name,
+    )?;
+    Ok((field, mask_time))
+}
+
 impl ArmRun {
     /// Builds arm `index` of `world` into `physics`: its mask and field (an intractable target
     /// is an error before the solve), its bodies at the start.
@@ -107,33 +146,7 @@ impl ArmRun {
     ) -> Result<Self, FieldError> {
         let settings = world.arms[index].clone();
         let chain = settings.chain();
-        let axes: Vec<JointAxis> = (settings.links.iter())
-            .map(|l| JointAxis {
-                cells: settings.cells(),
-                limits: l.limits,
-            })
-            .collect();
-        let started = Instant::now();
-        let mask = JointMask::build(&chain, &axes, walls, world.bounds());
-        let mask_time = started.elapsed();
-        let target = match (&settings.target_joints, settings.target_point) {
-            (Some(q), _) => JointTarget::Joints {
-                q: q.clone(),
-                radius: settings.target_radius,
-            },
-            (None, Some(point)) => JointTarget::Point {
-                point,
-                radius: settings.target_radius,
-            },
-            (None, None) => unreachable!("validated: one target"),
-        };
-        let field = JointField::solve(
-            &chain,
-            mask,
-            (&settings.start, &target),
-            world.field.tolerance,
-            &settings.name,
-        )?;
+        let (field, mask_time) = solve_field(world, &settings, walls)?;
         let bodies = ArmBodies::insert(physics, &chain, &settings.start);
         let s = &settings.controller;
         let guidance = world.field.guidance;
