@@ -408,6 +408,30 @@ fn read_npy(path: &Path) -> (String, Vec<u8>) {
     (header, bytes[10 + header_len..].to_vec())
 }
 
+/// Checks an exported field's `W` (float64 bytes) against its mask (bytes): 1 on the target
+/// set, in (0, 1) on the other reachable cells, 0 on the others; returns how many cells are in
+/// the target set, the other reachable cells, and the rest.
+fn w_classes(mask: &[u8], w: &[u8]) -> (usize, usize, usize) {
+    let w = w
+        .chunks(8)
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()));
+    let (mut target, mut inside, mut other) = (0, 0, 0);
+    for (m, w) in mask.iter().zip(w) {
+        match m {
+            0 if w == 1.0 => target += 1,
+            0 => {
+                assert!(w > 0.0 && w < 1.0, "{w}");
+                inside += 1;
+            }
+            _ => {
+                assert_eq!(w, 0.0);
+                other += 1;
+            }
+        }
+    }
+    (target, inside, other)
+}
+
 #[test]
 fn field_exports_numpy_arrays_and_a_picture() {
     let dir = tempfile::tempdir().unwrap();
@@ -838,32 +862,16 @@ fn a_shaped_agents_run_is_recorded_and_its_field_exported() {
     let (header, mask) = read("couch.mask.npy");
     assert!(header.contains("'shape': (161, 101, 96)"), "{header}");
     let (_, w) = read("couch.w.npy");
-    let w: Vec<f64> = w
-        .chunks(8)
-        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-        .collect();
-    // W is 1 on the target set, in (0, 1) on the other reachable cells, 0 on blocked ones.
-    let (mut target, mut inside) = (0, 0);
-    for (m, w) in mask.iter().zip(&w) {
-        match m {
-            0 if *w == 1.0 => target += 1,
-            0 => {
-                assert!(*w > 0.0 && *w < 1.0, "{w}");
-                inside += 1;
-            }
-            _ => assert_eq!(*w, 0.0),
-        }
-    }
+    let (target, inside, _) = w_classes(&mask, &w);
     assert!(target > 0 && inside > 100_000, "{target} {inside}");
     assert!(dir.path().join("couch.png").is_file());
 }
 
-/// An arm's run (issue 27) is recorded: its links per step, its tip's trail, its joint-space
-/// field and path (two links), and its joint angles and torques.
-#[test]
-fn an_arms_run_is_recorded_with_its_joint_space() {
+/// The recording of the first second of an arm world's run (its expectation of reaching
+/// lifted).
+fn arm_recording(name: &str) -> Recording {
     let dir = tempfile::tempdir().unwrap();
-    let world = world_path("arm-post.toml");
+    let world = world_path(name);
     let out = nadf(
         dir.path(),
         &[
@@ -878,7 +886,14 @@ fn an_arms_run_is_recorded_with_its_joint_space() {
         ],
     );
     common::assert_success(&out);
-    let recording = Recording::read(&dir.path().join("arm.rrd"));
+    Recording::read(&dir.path().join("arm.rrd"))
+}
+
+/// An arm's run (issue 27) is recorded: its links per step, its tip's trail, its joint-space
+/// field and path (two links), and its joint angles and torques.
+#[test]
+fn an_arms_run_is_recorded_with_its_joint_space() {
+    let recording = arm_recording("arm-post.toml");
     recording.assert_has(&[
         "world/arms/arm/links",
         "world/arms/arm/trail",
@@ -900,23 +915,7 @@ fn an_arms_run_is_recorded_with_its_joint_space() {
 /// about 0.6 rad in its first second: several slices), with the path projected on it.
 #[test]
 fn a_three_link_arms_joint_space_is_the_slice_through_its_first_joint() {
-    let dir = tempfile::tempdir().unwrap();
-    let world = world_path("arm-shelf.toml");
-    let out = nadf(
-        dir.path(),
-        &[
-            "run",
-            world.to_str().unwrap(),
-            "--set",
-            "duration=1",
-            "--set",
-            "arms.0.expect.reached=false",
-            "-o",
-            "shelf.rrd",
-        ],
-    );
-    common::assert_success(&out);
-    let recording = Recording::read(&dir.path().join("shelf.rrd"));
+    let recording = arm_recording("arm-shelf.toml");
     recording.assert_has(&["joint_space/arm/field", "joint_space/arm/path"]);
     let slices = recording.rows("joint_space/arm/field", "Image:buffer");
     println!("{slices} slices");
@@ -941,23 +940,7 @@ fn field_exports_an_arms_joint_space() {
     let (header, mask) = read_npy(&dir.path().join("arm.mask.npy"));
     assert!(header.contains("'shape': (256, 256)"), "{header}");
     let (_, w) = read_npy(&dir.path().join("arm.w.npy"));
-    let w: Vec<f64> = (w.chunks(8))
-        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-        .collect();
-    let (mut target, mut inside, mut blocked) = (0, 0, 0);
-    for (m, w) in mask.iter().zip(&w) {
-        match m {
-            0 if *w == 1.0 => target += 1,
-            0 => {
-                assert!(*w > 0.0 && *w < 1.0, "{w}");
-                inside += 1;
-            }
-            _ => {
-                assert_eq!(*w, 0.0);
-                blocked += 1;
-            }
-        }
-    }
+    let (target, inside, blocked) = w_classes(&mask, &w);
     assert!(
         target > 0 && inside > 50_000 && blocked > 1_000,
         "{target} {inside} {blocked}"

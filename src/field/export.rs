@@ -7,7 +7,7 @@
 //! cell of those joint cells (see [`super::JointAxis::center`]).
 
 use super::grid::Grid;
-use super::{HarmonicField, JointField, PoseField};
+use super::{HarmonicField, JointField, PoseField, ScaledW};
 
 /// The class of a cell in the mask array, stored as its `u8` value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -54,45 +54,56 @@ fn npy_of(
     out
 }
 
-/// An `[nx, ny, headings]` array of a shaped agent's field.
-fn pose_npy(
-    field: &PoseField,
-    descr: &str,
-    element_bytes: usize,
-    data: impl Fn(usize) -> Vec<u8>,
-) -> Vec<u8> {
-    let d = field.dims();
-    let cells = (0..d.nx)
-        .flat_map(move |i| (0..d.ny).flat_map(move |j| (0..d.nt).map(move |k| d.index(i, j, k))));
-    npy_of(&[d.nx, d.ny, d.nt], descr, element_bytes, cells.map(data))
-}
-
 /// The four arrays of a shaped agent's field, as for a disc's: `V`, `W = 1 − V`, `log10 W` and
 /// the mask, each `[nx, ny, headings]`.
 pub fn pose_arrays(field: &PoseField) -> [Vec<u8>; 4] {
-    let w = &field.w;
+    let d = field.dims();
+    let cells = (0..d.nx)
+        .flat_map(move |i| (0..d.ny).flat_map(move |j| (0..d.nt).map(move |k| d.index(i, j, k))));
+    four_arrays(
+        (&field.w, &field.mask.blocked, &field.reachable),
+        &[d.nx, d.ny, d.nt],
+        cells,
+    )
+}
+
+/// `V`, `W`, `log10 W` and the mask of a field of `shape`, its cells' indices taken in the
+/// arrays' C order from `cells`.
+fn four_arrays(
+    (w, blocked, reachable): (&ScaledW, &[bool], &[bool]),
+    shape: &[usize],
+    cells: impl Iterator<Item = usize> + Clone,
+) -> [Vec<u8>; 4] {
     let class = |c: usize| {
-        if field.mask.blocked[c] {
+        if blocked[c] {
             CellClass::Blocked
-        } else if field.reachable[c] {
+        } else if reachable[c] {
             CellClass::Reachable
         } else {
             CellClass::Unreachable
         }
     };
-    let value = |c: usize| if field.reachable[c] { w.value(c) } else { 0.0 };
+    let value = |c: usize| if reachable[c] { w.value(c) } else { 0.0 };
     let log = |c: usize| {
-        if field.reachable[c] {
+        if reachable[c] {
             w.log10(c)
         } else {
             f64::NEG_INFINITY
         }
     };
+    let f8 = |f: &dyn Fn(usize) -> f64| {
+        npy_of(
+            shape,
+            "<f8",
+            8,
+            cells.clone().map(|c| f(c).to_le_bytes().to_vec()),
+        )
+    };
     [
-        pose_npy(field, "<f8", 8, |c| (1.0 - value(c)).to_le_bytes().to_vec()),
-        pose_npy(field, "<f8", 8, |c| value(c).to_le_bytes().to_vec()),
-        pose_npy(field, "<f8", 8, |c| log(c).to_le_bytes().to_vec()),
-        pose_npy(field, "|u1", 1, |c| vec![class(c) as u8]),
+        f8(&|c| 1.0 - value(c)),
+        f8(&value),
+        f8(&log),
+        npy_of(shape, "|u1", 1, cells.clone().map(|c| vec![class(c) as u8])),
     ]
 }
 
@@ -112,50 +123,13 @@ pub fn pose_arrays(field: &PoseField) -> [Vec<u8>; 4] {
 /// assert!(String::from_utf8_lossy(&v[..128]).contains("'shape': (16, 16)"));
 /// ```
 pub fn joint_arrays(field: &JointField) -> [Vec<u8>; 4] {
-    let w = &field.w;
-    let class = |c: usize| {
-        if field.mask.blocked[c] {
-            CellClass::Blocked
-        } else if field.reachable[c] {
-            CellClass::Reachable
-        } else {
-            CellClass::Unreachable
-        }
-    };
-    let value = |c: usize| if field.reachable[c] { w.value(c) } else { 0.0 };
-    let log = |c: usize| {
-        if field.reachable[c] {
-            w.log10(c)
-        } else {
-            f64::NEG_INFINITY
-        }
-    };
     // The mask's index is C order over the joints' cells, the last joint fastest.
     let shape: Vec<usize> = field.mask.axes.iter().map(|a| a.cells).collect();
-    let cells = 0..field.mask.blocked.len();
-    [
-        npy_of(
-            &shape,
-            "<f8",
-            8,
-            cells
-                .clone()
-                .map(|c| (1.0 - value(c)).to_le_bytes().to_vec()),
-        ),
-        npy_of(
-            &shape,
-            "<f8",
-            8,
-            cells.clone().map(|c| value(c).to_le_bytes().to_vec()),
-        ),
-        npy_of(
-            &shape,
-            "<f8",
-            8,
-            cells.clone().map(|c| log(c).to_le_bytes().to_vec()),
-        ),
-        npy_of(&shape, "|u1", 1, cells.map(|c| vec![class(c) as u8])),
-    ]
+    four_arrays(
+        (&field.w, &field.mask.blocked, &field.reachable),
+        &shape,
+        0..field.mask.blocked.len(),
+    )
 }
 
 /// `V = 1 − W` per cell as little-endian float64 (exactly 1 where `W` is below 1e-16).
