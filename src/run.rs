@@ -13,6 +13,7 @@ use crate::output::{self, OutputError};
 use crate::record::{RecordError, Recorder, Viewer};
 use crate::sim::Simulation;
 use crate::sim::arm_run::ArmSummary;
+use crate::sim::drive::DriveSummary;
 use crate::sim::pendulum::PendulumSummary;
 use crate::sim::shaped::ShapedSummary;
 use crate::world::World;
@@ -70,6 +71,10 @@ pub struct Report {
     /// One summary per arm, in the world file's order (left out of the JSON when none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub arms: Vec<ArmSummary>,
+    /// The wheels of each agent on wheels, in the world file's order (left out of the JSON
+    /// when none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub drives: Vec<DriveSummary>,
     /// Wall-clock time of the whole run (fields, simulation, recording).
     #[serde(skip)]
     pub wall_time: Duration,
@@ -225,10 +230,11 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         failures.extend(crate::expect::shaped_failures(world, &shaped));
         failures.extend(crate::expect::arm_failures(world, &arms));
         let mut markdown = format!(
-            "```\n{}{}{}```\n\n",
+            "```\n{}{}{}{}```\n\n",
             metrics::table(&summaries),
             shaped_table(&shaped),
-            arm_table(&arms)
+            arm_table(&arms),
+            drive_table(&sim.drive_summaries())
         );
         markdown += &match (interrupted_at, failures.is_empty()) {
             (Some(t), _) => format!("**Interrupted** at {t:.2} s.\n"),
@@ -255,6 +261,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         pendulums: sim.pendulum_summaries(),
         shaped: sim.shaped_summaries(),
         arms: sim.arm_summaries(),
+        drives: sim.drive_summaries(),
         wall_time: started.elapsed(),
         recording,
         fields,
@@ -264,6 +271,12 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         output::write_atomically(path, report.to_json().as_bytes())?;
     }
     Ok(report)
+}
+
+/// The wheels' summaries as a table.
+fn drive_table(drives: &[DriveSummary]) -> String {
+    let rows: Vec<(&str, &DriveSummary)> = drives.iter().map(|d| (d.name.as_str(), d)).collect();
+    metrics::rows_table("wheels", &rows)
 }
 
 /// The arms' summaries as a table.
@@ -329,6 +342,7 @@ impl Report {
         out += &metrics::table(&self.agents);
         out += &shaped_table(&self.shaped);
         out += &arm_table(&self.arms);
+        out += &drive_table(&self.drives);
         if !self.pendulums.is_empty() {
             out += &format!(
                 "{:<12} {:>12} {:>9} {:>12} {:>8} {:>7}\n",

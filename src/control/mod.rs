@@ -230,6 +230,8 @@ impl<const N: usize> Controller<N> {
             ControllerKind::Orca => vec![Box::new(VelocityTracking {
                 b: mass / settings.orca.unwrap_or_default().tracking_time,
             })],
+            // The unicycle law commands the wheels' speeds itself (`sim::drive`): no force.
+            ControllerKind::Unicycle => Vec::new(),
         };
         Self {
             laws,
@@ -272,6 +274,7 @@ mod tests {
             bias: None,
             integration: Integration::Exact,
             orca: None,
+            turn_gain: None,
         }
     }
 

@@ -20,6 +20,7 @@ use nalgebra::Vector2;
 use rapier2d::prelude::{ColliderHandle, PhysicsWorld};
 
 use super::body::{Body, DiscBody, Sensed, control};
+use super::drive::{DriveBody, DriveMetrics, DriveSummary, Wheels};
 use super::faults::{FaultMonitor, Observation};
 use super::lidar::Lidar;
 use super::physics::{self, from_rapier};
@@ -56,7 +57,9 @@ pub struct AgentRun {
     pub metrics: Metrics,
     /// Its numerical faults so far.
     pub faults: FaultMonitor,
-    body: DiscBody,
+    body: AgentBody,
+    /// With wheels: what they measured so far.
+    pub drive: Option<DriveMetrics>,
     collider: ColliderHandle,
     /// The colliders it touched after the last step.
     touching: HashSet<ColliderHandle>,
@@ -72,6 +75,37 @@ pub struct AgentRun {
     replans: usize,
     /// What the current step has produced so far.
     log: StepLog,
+}
+
+/// An agent's body: a disc pushed in any direction, or a robot on wheels steered by its
+/// look-ahead point (the agent's position, to everything that plans or measures).
+enum AgentBody {
+    Disc(DiscBody),
+    Drive(DriveBody),
+}
+
+impl AgentBody {
+    fn state(&self, physics: &PhysicsWorld) -> Option<([f64; 2], Vector2<f64>)> {
+        match self {
+            Self::Disc(b) => b.state(physics),
+            Self::Drive(b) => b.state(physics),
+        }
+    }
+
+    /// Applies `force` for the next step; a drive's wheels report what they did.
+    fn actuate(&self, physics: &mut PhysicsWorld, force: &Vector2<f64>) -> Option<Wheels> {
+        match self {
+            Self::Disc(b) => {
+                b.actuate(physics, force);
+                None
+            }
+            Self::Drive(b) => {
+                let wheels = b.wheels(physics, force);
+                b.apply(physics, &wheels);
+                Some(wheels)
+            }
+        }
+    }
 }
 
 /// A lidar agent's sensor and what it knows.
@@ -94,6 +128,7 @@ struct StepLog {
     notes: Vec<String>,
     sensed_walls: Option<Vec<[f64; 2]>>,
     scan: Option<Vec<Beam>>,
+    wheels: Option<Wheels>,
 }
 
 /// An agent's part of a step, read before any field is re-solved.
@@ -221,7 +256,16 @@ impl AgentRun {
             lidar,
             kinematic,
             faults: FaultMonitor::default(),
-            body: DiscBody { handle: body },
+            body: match agent.drive {
+                None => AgentBody::Disc(DiscBody { handle: body }),
+                Some(_) => AgentBody::Drive(DriveBody::new(
+                    body,
+                    agent,
+                    world.dt,
+                    world.external_acceleration,
+                )),
+            },
+            drive: agent.drive.map(|_| DriveMetrics::default()),
             collider,
             touching: HashSet::new(),
             frozen: false,
@@ -251,13 +295,31 @@ impl AgentRun {
     /// Its disc and velocity where it is now (where it last was, at rest, if Rapier's state is
     /// not finite): an obstacle in the other agents' fields, a neighbour for ORCA.
     pub(super) fn body(&self, physics: &PhysicsWorld) -> Neighbour {
-        let body = &physics.bodies[self.body.handle];
-        let (p, v) = (from_rapier(body.translation()), from_rapier(body.linvel()));
-        let finite = p.iter().chain(v.iter()).all(|c| c.is_finite());
+        // A robot on wheels is its look-ahead point with the disc that holds it all.
+        let (p, v) = self
+            .body
+            .state(physics)
+            .map_or((self.last_position(), Vector2::zeros()), |(p, v)| {
+                (Vector2::from(p), v)
+            });
         Neighbour {
-            position: if finite { p } else { self.last_position() },
-            velocity: if finite { v } else { Vector2::zeros() },
+            position: p,
+            velocity: v,
             radius: self.agent.radius,
+        }
+    }
+
+    /// With wheels: its summary beside the agent's.
+    pub fn drive_summary(&self) -> Option<DriveSummary> {
+        (self.drive.as_ref()).map(|d| d.summary(&self.agent.name, &self.kinematic))
+    }
+
+    /// The disc that collides, m: the agent's (a robot on wheels: its footprint at its axle,
+    /// not the look-ahead point's larger disc).
+    fn footprint(&self, physics: &PhysicsWorld, position: Vector2<f64>) -> (Vector2<f64>, f64) {
+        match (&self.body, &self.agent.drive) {
+            (AgentBody::Drive(b), Some(d)) => (b.axle(physics), d.body_radius),
+            _ => (position, self.agent.radius),
         }
     }
 
@@ -422,6 +484,7 @@ impl AgentRun {
         physics: &mut PhysicsWorld,
         dt: f64,
     ) {
+        let x0 = plan.x;
         if !self.frozen {
             let (x, v) = (plan.x, plan.v);
             let neighbours = std::mem::take(&mut plan.neighbours);
@@ -437,8 +500,25 @@ impl AgentRun {
                 control.force = -v * (self.agent.mass / dt);
             }
         }
-        let force = self.log.control.map_or(Vector2::zeros(), |c| c.force);
-        self.body.actuate(physics, &force);
+        let mut force = self.log.control.map_or(Vector2::zeros(), |c| c.force);
+        let c = &self.agent.controller;
+        match (&self.body, &self.agent.drive) {
+            (AgentBody::Drive(body), Some(drive))
+                if c.kind == ControllerKind::Unicycle && !self.frozen =>
+            {
+                // The peers' baseline commands the wheels itself, on the same field.
+                let x = x0 + self.position_error;
+                let guidance = self.field.gradient(x.into()).and_then(|g| unit(&-g));
+                let distance = (x - Vector2::from(self.agent.target)).norm();
+                let v_max = c.speed_limit.unwrap_or(drive.max_wheel_speed);
+                let gains = (v_max, c.turn_gain.unwrap_or(2.0), c.capture_radius);
+                let wheels = body.unicycle(physics, guidance, gains, distance);
+                force = body.body_force(physics, &wheels);
+                body.apply(physics, &wheels);
+                self.log.wheels = Some(wheels);
+            }
+            _ => self.log.wheels = self.body.actuate(physics, &force),
+        }
         self.metrics.record_force(force);
     }
 
@@ -459,7 +539,8 @@ impl AgentRun {
             .gradient(p)
             .and_then(|g| unit(&g))
             .map_or(0.0, |u| -u.dot(&velocity));
-        let signed = index.signed_clearance(walls, position, self.agent.radius);
+        let (centre, radius) = self.footprint(physics, position);
+        let signed = index.signed_clearance(walls, centre, radius);
         let clearance = signed.max(0.0);
         let faults = self.faults.observe(&Observation {
             field: &self.field,
@@ -468,7 +549,10 @@ impl AgentRun {
             bounds,
         });
         self.log.events.extend(faults);
-        let contact_points = self.contacts(physics, position);
+        let contact_points = self.contacts(physics, (centre, radius));
+        if let (Some(metrics), Some(wheels)) = (&mut self.drive, self.log.wheels) {
+            metrics.record(&wheels, centre);
+        }
         self.metrics
             .record_state(time, position, velocity, clearance);
         let log = std::mem::take(&mut self.log);
@@ -618,7 +702,11 @@ impl AgentRun {
 
     /// Counts the contacts that started in the last step and returns where the body touches
     /// something now.
-    fn contacts(&mut self, physics: &PhysicsWorld, position: Vector2<f64>) -> Vec<Vector2<f64>> {
+    fn contacts(
+        &mut self,
+        physics: &PhysicsWorld,
+        (position, radius): (Vector2<f64>, f64),
+    ) -> Vec<Vector2<f64>> {
         let mut now = HashSet::new();
         let mut points = Vec::new();
         for pair in physics.narrow_phase.contact_pairs_with(self.collider) {
@@ -638,7 +726,7 @@ impl AgentRun {
                 {
                     // The normal points from collider 1 to collider 2.
                     let n = from_rapier(manifold.data.normal);
-                    points.push(position + n * (side * self.agent.radius));
+                    points.push(position + n * (side * radius));
                     now.insert(other);
                 }
             }

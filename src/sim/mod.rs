@@ -20,6 +20,7 @@ pub mod arm;
 pub mod arm_run;
 pub mod body;
 mod clearance;
+pub mod drive;
 pub mod faults;
 pub mod lidar;
 pub mod pendulum;
@@ -243,6 +244,14 @@ impl Simulation {
     /// Each shaped agent's summary so far.
     pub fn shaped_summaries(&self) -> Vec<shaped::ShapedSummary> {
         self.shaped.iter().map(shaped::ShapedRun::summary).collect()
+    }
+
+    /// The wheels' summary of each agent on wheels so far.
+    pub fn drive_summaries(&self) -> Vec<drive::DriveSummary> {
+        self.agents
+            .iter()
+            .filter_map(AgentRun::drive_summary)
+            .collect()
     }
 
     /// Each agent's summary so far.

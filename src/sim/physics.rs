@@ -55,6 +55,30 @@ pub fn insert_agent(
     physics: &mut PhysicsWorld,
     agent: &Agent,
 ) -> (RigidBodyHandle, ColliderHandle) {
+    if let Some(drive) = &agent.drive {
+        // On wheels: the footprint at the axle, behind the look-ahead point the agent's start
+        // is (see the loader), turning freely.
+        let l = drive.lookahead_for(drive.body_radius);
+        let (s, c) = agent.heading.sin_cos();
+        let axle = [agent.start[0] - l * c, agent.start[1] - l * s];
+        let r = drive.body_radius;
+        let inertia = agent.inertia.unwrap_or(0.5 * agent.mass * r * r);
+        let body = RigidBodyBuilder::dynamic()
+            .translation(Vector::new(axle[0] as f32, axle[1] as f32))
+            .rotation(agent.heading as f32)
+            .can_sleep(false)
+            .ccd_enabled(true)
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                agent.mass as f32,
+                inertia as f32,
+            ));
+        let collider = ColliderBuilder::ball(r as f32)
+            .density(0.0)
+            .friction(0.0)
+            .restitution(0.0);
+        return physics.insert(body, collider);
+    }
     let [vx, vy] = agent.initial_velocity;
     let body = RigidBodyBuilder::dynamic()
         .translation(Vector::new(agent.start[0] as f32, agent.start[1] as f32))

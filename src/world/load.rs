@@ -270,6 +270,26 @@ fn parse(text: &str, file: &Path) -> Result<World, Vec<Problem>> {
             .into_iter()
             .partition(Agent::is_shaped);
         (world.agents, world.shaped) = (discs, shaped);
+        // A robot on wheels is steered by its look-ahead point (`sim::drive`): every part of
+        // the sandbox that plans for a disc plans for that point, with a disc grown by the
+        // look-ahead that holds the whole robot at any heading.
+        for agent in &mut world.agents {
+            if let Some(drive) = &mut agent.drive {
+                let l = drive.lookahead_for(agent.radius);
+                drive.lookahead = Some(l);
+                drive.body_radius = agent.radius;
+                let (s, c) = agent.heading.sin_cos();
+                agent.start = [agent.start[0] + l * c, agent.start[1] + l * s];
+                agent.radius += l;
+                // The point's speed limit: the fastest it may move in any direction with both
+                // wheels within theirs, so that the wheels can always still turn it.
+                if agent.controller.kind != crate::world::ControllerKind::Unicycle {
+                    let v = drive.point_speed(l);
+                    let limit = agent.controller.speed_limit.map_or(v, |u| u.min(v));
+                    agent.controller.speed_limit = Some(limit);
+                }
+            }
+        }
         Ok(world)
     } else {
         Err(issues

@@ -19,10 +19,10 @@ pub use error::{WorldError, WorldErrors};
 pub use load::{Override, WorldFile, load, load_str};
 pub use schema::{
     Agent, AgentShape, ArmSettings, Attraction, BiasSettings, ClampSettings, ControllerKind,
-    ControllerSettings, DEFAULT_K, Expect, ExpectValue, FieldKind, FieldSettings, GuidanceKind,
-    Integration, LinkSettings, LoadedMap, MAX_CELLS, MapSettings, OUTER_WALL_THICKNESS,
-    OrcaSettings, Pendulum, PendulumController, PendulumExpect, Replan, SensorKind, SensorSettings,
-    UnknownCells, Wall, World,
+    ControllerSettings, DEFAULT_K, DriveKind, DriveSettings, Expect, ExpectValue, FieldKind,
+    FieldSettings, GuidanceKind, Integration, LinkSettings, LoadedMap, MAX_CELLS, MapSettings,
+    OUTER_WALL_THICKNESS, OrcaSettings, Pendulum, PendulumController, PendulumExpect, Replan,
+    SensorKind, SensorSettings, UnknownCells, Wall, World,
 };
 pub use shapes::{
     WallShape, all_wall_shapes, all_walls, drawn_walls, named_walls, outer_walls, outline_box,

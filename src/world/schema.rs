@@ -396,9 +396,66 @@ pub struct Agent {
     /// Noisy sensing of the walls (default: the agent knows the walls exactly).
     #[serde(default)]
     pub sensor: Option<SensorSettings>,
+    /// Wheels (default: none, the disc is pushed in any direction). With a drive the disc turns
+    /// and is driven by its wheels (`sim::drive`); `start` is its axle's centre at `heading`.
+    #[serde(default)]
+    pub drive: Option<DriveSettings>,
     /// What this agent's run must show, on top of the world's `[expect]`.
     #[serde(default)]
     pub expect: Option<Expect>,
+}
+
+/// An agent's wheels (`[agents.drive]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveSettings {
+    /// The kind of drive.
+    pub kind: DriveKind,
+    /// Distance between the two wheels' contact points, m (a TurtleBot3 Burger: 0.160).
+    pub wheel_separation: f64,
+    /// Each wheel's largest ground speed, m/s (a Burger: 0.22).
+    pub max_wheel_speed: f64,
+    /// Each wheel's largest traction force, N.
+    pub max_wheel_force: f64,
+    /// The largest sideways friction before the robot skids, N (default: it never skids).
+    #[serde(default)]
+    pub lateral_grip: Option<f64>,
+    /// How far ahead of the axle the controlled point is, m (default the radius: the front of
+    /// the footprint): that point is fully actuated, and the controller steers it as a disc. A
+    /// longer look-ahead lets the point go faster ([`DriveSettings::point_speed`]) and plans
+    /// for a larger disc.
+    #[serde(default)]
+    pub lookahead: Option<f64>,
+    /// The footprint's radius, m: the agent's `radius` as the world file gives it (the loader
+    /// then grows the agent's radius by the look-ahead, the disc its field is planned for).
+    #[serde(skip)]
+    pub body_radius: f64,
+}
+
+impl DriveSettings {
+    /// The look-ahead, m, for a footprint of `radius` m.
+    pub fn lookahead_for(&self, radius: f64) -> f64 {
+        self.lookahead.unwrap_or(radius)
+    }
+
+    /// The fastest the look-ahead point `lookahead` m ahead of the axle may move in any
+    /// direction with both wheels within `max_wheel_speed`, m/s: its velocity is
+    /// `u h + ℓω n`, the wheels' speeds `u ± ωs/2`, and the largest of those over
+    /// `u² + (ℓω)² = v²` is `v √(1 + (s/2ℓ)²)`. The loader makes it the controller's speed
+    /// limit (or the `speed_limit` given, if lower), so that the wheels always have the speed
+    /// left to turn the point: at the wheels' own limit the point could only go straight.
+    pub fn point_speed(&self, lookahead: f64) -> f64 {
+        let ratio = self.wheel_separation / (2.0 * lookahead);
+        self.max_wheel_speed / (1.0 + ratio * ratio).sqrt()
+    }
+}
+
+/// The kinds of drive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DriveKind {
+    /// Two wheels on one axle through the disc's centre, no sideways motion: a TurtleBot's.
+    Differential,
 }
 
 /// An agent's shape (`[agents.shape]`), in the body frame, m. Polygons are convex and
@@ -654,6 +711,11 @@ pub struct ControllerSettings {
     /// `kind = "orca"`: ORCA's settings (defaults when absent).
     #[serde(default)]
     pub orca: Option<OrcaSettings>,
+    /// The unicycle law's turn gain `k`, 1/s (default 2: a heading error of 0.5 rad turns at
+    /// 1 rad/s). Only for `kind = "unicycle"`, whose `v_max` is `speed_limit` (default the
+    /// wheels' largest speed).
+    #[serde(default)]
+    pub turn_gain: Option<f64>,
 }
 
 /// The `[agents.controller.orca]` table: optimal reciprocal collision avoidance's settings
@@ -801,6 +863,10 @@ pub enum ControllerKind {
     /// (optimal reciprocal collision avoidance, van den Berg et al. 2011) among the other
     /// agents, tracked by a force (`control::Orca`). The baseline of crowds.
     Orca,
+    /// Not the paper's: the kinematic unicycle law of the peers (navground, ir-sim) on the
+    /// same field, for a robot on wheels: forward speed `v_max cos e` and turn rate `k e`, `e`
+    /// the angle from the heading to the guidance, tracked by the wheels (`sim::drive`).
+    Unicycle,
 }
 
 impl ControllerKind {
@@ -811,6 +877,7 @@ impl ControllerKind {
             Self::Viscous => "viscous",
             Self::SlidingMode => "sliding-mode",
             Self::Orca => "orca",
+            Self::Unicycle => "unicycle",
         }
     }
 }

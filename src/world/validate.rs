@@ -533,8 +533,8 @@ pub fn condition_40(world: &World) -> Vec<(String, String)> {
                     ));
                 }
             }
-            // ORCA tracks a velocity; it has no guidance force to compare.
-            ControllerKind::Orca => {}
+            // ORCA and the unicycle track a velocity; they have no guidance force to compare.
+            ControllerKind::Orca | ControllerKind::Unicycle => {}
             ControllerKind::SlidingMode => {
                 let f0 = c.f0.unwrap_or(0.0);
                 if f0 <= external {
@@ -673,6 +673,21 @@ fn check_controller(
             unused(&mut *bad, "vd", c.vd);
             unused(&mut *bad, "f0", c.f0);
         }
+        ControllerKind::Unicycle => {
+            unused(&mut *bad, "k", c.k);
+            unused(&mut *bad, "b", c.b);
+            unused(&mut *bad, "vd", c.vd);
+            unused(&mut *bad, "f0", c.f0);
+        }
+    }
+    if c.kind != ControllerKind::Unicycle && c.turn_gain.is_some() {
+        bad(
+            key("turn_gain"),
+            format!("is not used by kind = \"{kind}\""),
+        );
+    }
+    if let Some(k) = c.turn_gain {
+        positive(bad, &key("turn_gain"), k);
     }
     if c.kind != ControllerKind::Orca && c.orca.is_some() {
         bad(key("orca"), format!("is not used by kind = \"{kind}\""));
@@ -890,18 +905,33 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
     let start_ok = finite_point(bad, &key("start"), agent.start);
     let target_ok = finite_point(bad, &key("target"), agent.target);
     if agent.is_shaped() {
+        if agent.drive.is_some() {
+            bad(
+                key("drive"),
+                "wheels are for a disc so far: a shape other than a disc is pushed and turned by forces ([agents.shape]); drop one of the two".into(),
+            );
+        }
         check_shaped(bad, world, i, agent, start_ok && target_ok);
         return;
     }
+    if let Some(drive) = &agent.drive {
+        check_drive(bad, i, agent, drive);
+    } else if agent.controller.kind == ControllerKind::Unicycle {
+        bad(
+            key("controller.kind"),
+            "unicycle steers a robot on wheels: give the agent an [agents.drive]".into(),
+        );
+    }
+    let turns = agent.drive.is_some();
     for (name, set) in [
-        ("heading", agent.heading != 0.0),
+        ("heading", agent.heading != 0.0 && !turns),
         ("target_heading", agent.target_heading.is_some()),
-        ("inertia", agent.inertia.is_some()),
+        ("inertia", agent.inertia.is_some() && !turns),
     ] {
         if set {
             bad(
                 key(name),
-                "only for an agent with a shape other than a disc ([agents.shape]): a disc does not turn".into(),
+                "only for an agent with a shape other than a disc ([agents.shape]) or with wheels ([agents.drive]): a disc without them does not turn".into(),
             );
         }
     }
@@ -976,6 +1006,77 @@ fn check_agent(bad: &mut impl FnMut(String, String), world: &World, i: usize, ag
                 );
             }
         }
+    }
+}
+
+/// The checks of an agent's wheels: positive separation, speed and force (and grip), a
+/// look-ahead inside the footprint (the controlled point must be ahead of the axle to be
+/// actuated, and on the body), a finite heading and inertia, and a law that acts on a point.
+fn check_drive(
+    bad: &mut impl FnMut(String, String),
+    i: usize,
+    agent: &Agent,
+    drive: &crate::world::DriveSettings,
+) {
+    let key = |k: &str| format!("agents.{i}.{k}");
+    for (name, value) in [
+        ("wheel_separation", Some(drive.wheel_separation)),
+        ("max_wheel_speed", Some(drive.max_wheel_speed)),
+        ("max_wheel_force", Some(drive.max_wheel_force)),
+        ("lateral_grip", drive.lateral_grip),
+    ] {
+        if let Some(v) = value
+            && !(v.is_finite() && v > 0.0)
+        {
+            bad(
+                key(&format!("drive.{name}")),
+                format!("must be a positive finite number, got {v}"),
+            );
+        }
+    }
+    if let Some(l) = drive.lookahead {
+        if !(l.is_finite() && l > 0.0) {
+            bad(
+                key("drive.lookahead"),
+                format!(
+                    "must be a positive finite distance ahead of the axle, got {l}: on the axle the point cannot be moved sideways (it is not actuated)"
+                ),
+            );
+        } else if agent.radius.is_finite() && l > agent.radius {
+            bad(
+                key("drive.lookahead"),
+                format!(
+                    "{l} m is beyond the body (radius {} m): the controlled point must be on the robot",
+                    agent.radius
+                ),
+            );
+        }
+    }
+    if !agent.heading.is_finite() {
+        bad(
+            key("heading"),
+            format!("must be a finite angle, got {}", agent.heading),
+        );
+    }
+    if let Some(inertia) = agent.inertia
+        && !(inertia.is_finite() && inertia > 0.0)
+    {
+        bad(
+            key("inertia"),
+            format!("must be a positive finite number, got {inertia}"),
+        );
+    }
+    if agent.controller.kind == ControllerKind::SlidingMode {
+        bad(
+            key("controller.kind"),
+            "sliding-mode is not supported with wheels: use nadf, viscous, orca or unicycle".into(),
+        );
+    }
+    if agent.initial_velocity != [0.0, 0.0] {
+        bad(
+            key("initial_velocity"),
+            "a robot on wheels starts at rest (a sideways velocity would break its grip)".into(),
+        );
     }
 }
 
