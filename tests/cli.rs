@@ -957,3 +957,43 @@ fn field_exports_an_arms_joint_space() {
             .contains("no agent or arm `nobody`; the world has: arm")
     );
 }
+
+/// A robot on wheels is recorded with its footprint turned by its heading at every step, its
+/// look-ahead point as the body, and its wheels' speeds and forces and its heading plotted.
+#[test]
+fn a_robot_on_wheels_is_recorded_with_its_footprint_and_wheels() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("burger-dead-end.toml");
+    let out = nadf(
+        dir.path(),
+        &[
+            "run",
+            world.to_str().unwrap(),
+            "--set",
+            "duration=2",
+            "--set",
+            "expect.reached=false",
+            "-o",
+            "wheels.rrd",
+        ],
+    );
+    common::assert_success(&out);
+    let recording = Recording::read(&dir.path().join("wheels.rrd"));
+    recording.assert_has(&[
+        "agents/burger/footprint",
+        "agents/burger/body",
+        "plots/burger/wheel_speeds[left wheel (m/s)]",
+        "plots/burger/wheel_forces[grip (N)]",
+        "plots/burger/heading[heading (rad)]",
+    ]);
+    // Two seconds at 10 ms: the footprint's frame at every step.
+    assert_eq!(
+        recording.rows("agents/burger/footprint", "Transform3D:rotation_axis_angle"),
+        200
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("wheel_mps") && stdout.contains("slip_mps"),
+        "{stdout}"
+    );
+}

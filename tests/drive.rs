@@ -183,3 +183,45 @@ fn bad_drives_are_located_errors() {
     let e = common::load_errors(pendulum, &[]);
     assert!(e.contains("drive"), "{e}");
 }
+
+/// Proposition 1 for the look-ahead point: under the paper's own law (`F = −K∇V`, NADF) with
+/// limits that never bind, the wheels give the point `m p̈ = F`, so `K·V(p) + ½ m |ṗ|²` never
+/// grows by more than integration error, while the heading, which the proposition does not
+/// cover, turns as it must (the robot starts facing the wall, its target to its right).
+#[test]
+fn proposition_1_holds_for_the_look_ahead_point() {
+    let world = common::world(
+        "waffle-room.toml",
+        &[
+            "field.guidance=\"gradient\"",
+            "agents.0.start=[5.0, 8.0]",
+            "agents.0.controller.k=20.0",
+            "agents.0.drive.max_wheel_speed=100.0",
+            "agents.0.drive.max_wheel_force=10000.0",
+            "agents.0.drive.lateral_grip=100000.0",
+            "agents.0.heading=-1.5707963267948966",
+            "duration=30.0",
+        ],
+    );
+    let (trace, summary) = common::trace(&world);
+    let (k, m) = (20.0, 1.8);
+    let energy = |s: &nadf::sim::AgentState| k * s.potential + 0.5 * m * s.velocity.norm_squared();
+    let e0 = energy(&trace[0].1);
+    let (mut worst, mut turned) = (0.0_f64, 0.0_f64);
+    for pair in trace.windows(2) {
+        let (a, b) = (&pair[0].1, &pair[1].1);
+        // Outside the target disc and its bowl, where the guidance is −K∇V of the solved V.
+        if b.distance > 0.4 {
+            worst = worst.max(energy(b) - energy(a));
+        }
+        let heading = |s: &nadf::sim::AgentState| s.axle.map_or(0.0, |(_, h)| h);
+        turned = turned.max((heading(b) - heading(&trace[0].1)).abs());
+    }
+    println!("largest rise {worst:e} of {e0}; turned {turned} rad; {summary:?}");
+    assert!(summary.reached && summary.contacts == 0, "{summary:?}");
+    assert!(
+        worst <= 1e-3 * e0,
+        "the point's energy rose by {worst} of {e0}"
+    );
+    assert!(turned > 1.0, "{turned}");
+}

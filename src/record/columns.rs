@@ -131,6 +131,8 @@ pub struct AgentColumns {
     /// The arrows in the body's frame (y turned over, see [`BODY_FLIP`]).
     velocities: Vec<[f32; 2]>,
     forces: Vec<[f32; 2]>,
+    /// With wheels: the footprint's frame per step (the axle's centre, the heading).
+    footprint: Vec<([f32; 3], f32)>,
     /// The body's colour: touching something or not.
     colours: Runs<rerun::Color>,
     contacts: Runs<Vec<[f32; 2]>>,
@@ -157,14 +159,28 @@ impl AgentColumns {
     /// arrows' and contacts' colours, the plots' labels.
     pub fn new(rec: &RecordingStream, run: &AgentRun) -> Result<Self, rerun::RecordingStreamError> {
         let paths = AgentPaths::of(&run.agent.name);
+        // A robot on wheels: the body frame is its look-ahead point, drawn as a dot; the robot
+        // is its footprint.
+        let dot = match &run.agent.drive {
+            Some(_) => size::points(size::CONTACT),
+            None => (run.agent.radius as f32).into(),
+        };
         rec.log_static(
             paths.body.as_str(),
             &[
                 &rerun::Transform3D::update_fields().with_scale(BODY_FLIP)
                     as &dyn rerun::AsComponents,
-                &rerun::Points2D::new([[0.0, 0.0]]).with_radii([run.agent.radius as f32]),
+                &rerun::Points2D::new([[0.0, 0.0]]).with_radii([dot]),
             ],
         )?;
+        if let Some(drive) = &run.agent.drive {
+            rec.log_static(
+                paths.footprint.as_str(),
+                &rerun::LineStrips2D::new(footprint(drive))
+                    .with_colors([palette::rerun(palette::BODY)])
+                    .with_radii([size::points(size::PATH)]),
+            )?;
+        }
         for (path, colour) in [
             (&paths.velocity, palette::VELOCITY),
             (&paths.force, palette::FORCE),
@@ -206,6 +222,7 @@ impl AgentColumns {
             translations: Vec::new(),
             velocities: Vec::new(),
             forces: Vec::new(),
+            footprint: Vec::new(),
             colours: Runs::default(),
             contacts: Runs::default(),
             plots,
@@ -238,6 +255,10 @@ impl AgentColumns {
                 v.y as f32 * scale * BODY_FLIP[1],
             ]
         };
+        if let Some((axle, heading)) = state.axle {
+            let [x, y] = f32x2(axle.into());
+            self.footprint.push(([x, y, 0.0], heading as f32));
+        }
         self.velocities.push(arrow(state.velocity, VELOCITY_SCALE));
         self.forces.push(arrow(state.force, FORCE_SCALE));
         let touching = !state.contact_points.is_empty();
@@ -304,6 +325,22 @@ impl AgentColumns {
                 .with_many_translation(std::mem::take(&mut self.translations))
                 .columns_of_unit_batches()?,
         )?;
+        let footprint = std::mem::take(&mut self.footprint);
+        if footprint.len() == times.len() {
+            let (at, angles): (Vec<[f32; 3]>, Vec<f32>) = footprint.into_iter().unzip();
+            let turns = angles.into_iter().map(|a| {
+                rerun::RotationAxisAngle::new([0.0, 0.0, 1.0], rerun::Angle::from_radians(a))
+            });
+            send(
+                rec,
+                &self.paths.footprint,
+                &times,
+                rerun::Transform3D::update_fields()
+                    .with_many_translation(at)
+                    .with_many_rotation_axis_angle(turns)
+                    .columns_of_unit_batches()?,
+            )?;
+        }
         for (path, vectors) in [
             (&self.paths.velocity, std::mem::take(&mut self.velocities)),
             (&self.paths.force, std::mem::take(&mut self.forces)),
@@ -342,6 +379,26 @@ impl AgentColumns {
         )?;
         Ok(())
     }
+}
+
+/// A robot on wheels' footprint in its own frame (the axle's centre at the origin, heading
+/// along x): its disc, a line from the centre to the front, and its two wheels.
+fn footprint(drive: &crate::world::DriveSettings) -> Vec<Vec<[f32; 2]>> {
+    let r = drive.body_radius as f32;
+    let circle = (0..=48)
+        .map(|k| {
+            let a = k as f32 * std::f32::consts::TAU / 48.0;
+            [r * a.cos(), r * a.sin()]
+        })
+        .collect();
+    let half = 0.5 * drive.wheel_separation as f32;
+    let wheel = 0.3 * r;
+    vec![
+        circle,
+        vec![[0.0, 0.0], [r, 0.0]],
+        vec![[-wheel, half], [wheel, half]],
+        vec![[-wheel, -half], [wheel, -half]],
+    ]
 }
 
 /// Sends `columns` of `entity`, one row per time of `times` (s on `sim_time`), unless there

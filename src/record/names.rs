@@ -62,6 +62,8 @@ pub struct AgentPaths {
     pub scan: String,
     /// The map its lidar has built: occupied, free, unknown.
     pub known_map: String,
+    /// A robot on wheels: its footprint at its axle, turned by its heading, with its wheels.
+    pub footprint: String,
 }
 
 impl AgentPaths {
@@ -83,6 +85,7 @@ impl AgentPaths {
             sensed_walls: path("sensed_walls"),
             scan: path("lidar/scan"),
             known_map: path("lidar/map"),
+            footprint: path("footprint"),
         }
     }
 
@@ -436,6 +439,55 @@ pub const AGENT_PLOTS: &[Plot<Agent, AgentState>] = &[
                 value: |_, s| flag(s.speed_limited),
             },
         ],
+    },
+    Plot {
+        key: "wheel_speeds",
+        piecewise_constant: false,
+        view: "wheel speeds (m/s)",
+        series: &[
+            Series {
+                label: "left wheel (m/s)",
+                shown: |a| a.drive.is_some(),
+                value: |_, s| s.wheels.map_or(0.0, |w| w.speeds[0]),
+            },
+            Series {
+                label: "right wheel (m/s)",
+                shown: |a| a.drive.is_some(),
+                value: |_, s| s.wheels.map_or(0.0, |w| w.speeds[1]),
+            },
+        ],
+    },
+    Plot {
+        key: "wheel_forces",
+        piecewise_constant: false,
+        view: "wheel forces (N)",
+        series: &[
+            Series {
+                label: "left wheel (N)",
+                shown: |a| a.drive.is_some(),
+                value: |_, s| s.wheels.map_or(0.0, |w| w.forces[0]),
+            },
+            Series {
+                label: "right wheel (N)",
+                shown: |a| a.drive.is_some(),
+                value: |_, s| s.wheels.map_or(0.0, |w| w.forces[1]),
+            },
+            Series {
+                label: "grip (N)",
+                shown: |a| a.drive.is_some(),
+                value: |_, s| s.wheels.map_or(0.0, |w| w.lateral_force),
+            },
+        ],
+    },
+    Plot {
+        key: "heading",
+        piecewise_constant: false,
+        view: "heading (rad)",
+        series: &[Series {
+            label: "heading (rad)",
+            shown: |a| a.drive.is_some(),
+            value: |_, s| s.axle.map_or(0.0, |(_, h)| h),
+        }],
     },
     Plot {
         key: "bias",

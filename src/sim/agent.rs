@@ -193,6 +193,10 @@ pub struct AgentState {
     pub notes: Vec<String>,
     /// The lidar scan taken in this step, if any.
     pub scan: Option<Vec<Beam>>,
+    /// With wheels: what they did in this step.
+    pub wheels: Option<Wheels>,
+    /// With wheels: the axle's centre, m, and the heading, rad, after this step.
+    pub axle: Option<(Vector2<f64>, f64)>,
 }
 
 impl AgentRun {
@@ -573,6 +577,11 @@ impl AgentRun {
             events: log.events,
             notes: log.notes,
             scan: log.scan,
+            wheels: log.wheels,
+            axle: match &self.body {
+                AgentBody::Drive(b) => Some((centre, b.heading(physics))),
+                AgentBody::Disc(_) => None,
+            },
         }
     }
 

@@ -148,6 +148,11 @@ impl DriveBody {
         self.kinematics(physics).centre
     }
 
+    /// The heading, rad (Rapier's angle, in (−π, π]).
+    pub fn heading(&self, physics: &PhysicsWorld) -> f64 {
+        self.kinematics(physics).theta
+    }
+
     /// The wheels' forces for the point force `force` (N), within the limits (see the module),
     /// and what they measure at the start of the step.
     pub fn wheels(&self, physics: &PhysicsWorld, force: &Vector2<f64>) -> Wheels {
