@@ -69,9 +69,11 @@ fn every_wheeled_world_reaches_untouched_within_the_wheels_limits() {
 
 /// Through its look-ahead point NADF follows the kinematic path closely and does not make the
 /// heading oscillate: δ_m of the point under 7 cm and no reversal of the turn in the TurtleBot3
-/// world, the paper's room and the dead end (measured 4.1, 6.2 and 3.6 cm); the peers' law
-/// turns back and forth in the dead end, where the guidance points straight behind it (55
-/// reversals measured), while NADF backs out without turning.
+/// world, the paper's room and the dead end (measured 4.1, 6.2 and 3.6 cm). In the dead end,
+/// started facing the side wall, both laws must turn in place (measured 1.7 and 2.7 rad/s).
+/// Started facing straight into it, NADF backs out without turning, while the peers' law turns
+/// back and forth as it reverses, where the guidance points straight behind it (55 reversals
+/// measured).
 #[test]
 fn nadf_keeps_the_point_on_the_path_and_the_heading_steady() {
     for name in [
@@ -83,8 +85,18 @@ fn nadf_keeps_the_point_on_the_path_and_the_heading_steady() {
         assert!(agent.max_deviation < 0.07, "{name}: {agent:?}");
         assert_eq!(wheels.heading_reversals, 0, "{name}: {wheels:?}");
     }
-    let (_, wheels) = drive_run("burger-dead-end.toml", true, &[]);
-    assert!(wheels.heading_reversals > 10, "{wheels:?}");
+    for unicycle in [false, true] {
+        let (_, wheels) = drive_run("burger-dead-end.toml", unicycle, &[]);
+        assert!(wheels.peak_turn_rate > 1.0, "{wheels:?}");
+    }
+    let straight = ["agents.0.heading=0.0"];
+    let (_, nadf) = drive_run("burger-dead-end.toml", false, &straight);
+    let (_, peers) = drive_run("burger-dead-end.toml", true, &straight);
+    assert!(
+        nadf.heading_reversals == 0 && nadf.peak_turn_rate < 0.1,
+        "{nadf:?}"
+    );
+    assert!(peers.heading_reversals > 10, "{peers:?}");
 }
 
 /// A weak grip lets the robot skid: its sideways speed is measured, far above the bound of a

@@ -21,9 +21,9 @@
 //! the largest fraction `σ ∈ [0, 1]` of it, `σ a`, that keeps all four within their limits over
 //! the step: the force keeps its direction, only its size shrinks (the drift terms `ℓω²` and
 //! `uω` are always compensated). When even `σ = 0` breaks a limit (a wheel pushed over its speed,
-//! or a turn whose drift the motors cannot hold), each wheel's force is clipped to its limit and
-//! set to bring its speed back to the limit: the point then follows the law only approximately,
-//! and the step is counted (`limited_steps`).
+//! or a turn whose drift the motors cannot hold), the wheels aim at the speeds the drift alone
+//! would give, clamped to their limit, with forces scaled down together to theirs: the point
+//! then follows the law only approximately, and the step is counted (`clipped_steps`).
 //!
 //! **Grip.** The ground's sideways force is whatever makes the axle's velocity at the end of the
 //! step lie along the heading at the end of the step, computed from the step's own update (so
@@ -204,20 +204,12 @@ impl DriveBody {
                 false,
             ),
             None => {
-                // Clip each wheel to its force limit, then so that its own speed ends at most
-                // at the limit (its effect on its own speed: dt (1/m + s²/4I) per newton).
-                let own = dt * (1.0 / m + s * s / (4.0 * i));
-                let clip = |f: f64, v: f64| {
-                    let f = f.clamp(-self.max_force, self.max_force);
-                    let (lo, hi) = ((-self.max_speed - v) / own, (self.max_speed - v) / own);
-                    f.clamp(lo.min(hi), hi.max(lo))
-                        .clamp(-self.max_force, self.max_force)
-                };
-                (
-                    [clip(left.0, speeds[0]), clip(right.0, speeds[1])],
-                    0.0,
-                    true,
-                )
+                // Even the drift breaks a limit: the wheels' speeds at the end of the step the
+                // drift would give, clamped to their limit, reached by forces within theirs.
+                let ends =
+                    [speed(-1.0).0, speed(1.0).0].map(|v| v.clamp(-self.max_speed, self.max_speed));
+                let (forces, _) = self.forces_for(&k, ends);
+                (forces, 0.0, true)
             }
         };
         Wheels {
@@ -281,35 +273,45 @@ impl DriveBody {
         }
         let u = k.velocity.dot(&h);
         let speeds = [u - k.omega * s / 2.0, u + k.omega * s / 2.0];
-        // Δv_l = dt (α F_l + β F_r), Δv_r = dt (β F_l + α F_r).
-        let alpha = 1.0 / self.mass + s * s / (4.0 * self.inertia);
-        let beta = 1.0 / self.mass - s * s / (4.0 * self.inertia);
-        let gravity = self.dt * self.gravity.dot(&h);
-        let (dl, dr) = (
-            (targets[0] - speeds[0] - gravity) / self.dt,
-            (targets[1] - speeds[1] - gravity) / self.dt,
-        );
-        let det = alpha * alpha - beta * beta;
-        let mut forces = [
-            (alpha * dl - beta * dr) / det,
-            (alpha * dr - beta * dl) / det,
-        ];
-        let strongest = forces[0].abs().max(forces[1].abs());
-        if strongest > self.max_force {
-            forces = forces.map(|f| f * self.max_force / strongest);
-        }
+        let (forces, scale) = self.forces_for(&k, targets);
         Wheels {
             forces,
             speeds,
             lateral_force: self.grip_force(&k, forces),
             slip: k.velocity.dot(&n),
-            scale: if strongest > self.max_force {
-                self.max_force / strongest
-            } else {
-                1.0
-            },
+            scale,
             clipped: false,
             heading: (k.theta, k.omega),
+        }
+    }
+
+    /// The wheels' forces (left, right) that bring their speeds to `targets` (m/s) at the end
+    /// of the step, scaled down together to within their limit, and that scale: each wheel's
+    /// force changes its own speed by `dt (1/m + s²/4I)` per newton and the other's by
+    /// `dt (1/m − s²/4I)`.
+    fn forces_for(&self, k: &Kinematics, targets: [f64; 2]) -> ([f64; 2], f64) {
+        let (s, dt) = (self.separation, self.dt);
+        let h = k.heading();
+        let u = k.velocity.dot(&h);
+        let speeds = [u - k.omega * s / 2.0, u + k.omega * s / 2.0];
+        let alpha = 1.0 / self.mass + s * s / (4.0 * self.inertia);
+        let beta = 1.0 / self.mass - s * s / (4.0 * self.inertia);
+        let gravity = dt * self.gravity.dot(&h);
+        let (dl, dr) = (
+            (targets[0] - speeds[0] - gravity) / dt,
+            (targets[1] - speeds[1] - gravity) / dt,
+        );
+        let det = alpha * alpha - beta * beta;
+        let forces = [
+            (alpha * dl - beta * dr) / det,
+            (alpha * dr - beta * dl) / det,
+        ];
+        let strongest = forces[0].abs().max(forces[1].abs());
+        if strongest > self.max_force {
+            let scale = self.max_force / strongest;
+            (forces.map(|f| f * scale), scale)
+        } else {
+            (forces, 1.0)
         }
     }
 
