@@ -127,10 +127,17 @@ impl DriveBody {
             max_force: drive.max_wheel_force,
             grip: drive.lateral_grip,
             mass: agent.mass,
-            inertia: agent.inertia.unwrap_or(0.5 * agent.mass * r * r),
+            inertia: Self::inertia_of(agent),
             dt,
             gravity: Vector2::from(gravity),
         }
+    }
+
+    /// The moment of inertia of `agent` on wheels about its axle's centre, kg·m²: `inertia`,
+    /// or a uniform disc's `½ m r²` of its footprint.
+    pub fn inertia_of(agent: &Agent) -> f64 {
+        let r = agent.drive.as_ref().map_or(agent.radius, |d| d.body_radius);
+        agent.inertia.unwrap_or(0.5 * agent.mass * r * r)
     }
 
     fn kinematics(&self, physics: &PhysicsWorld) -> Kinematics {
@@ -212,11 +219,23 @@ impl DriveBody {
                 (forces, 0.0, true)
             }
         };
+        self.report(&k, (forces, speeds), scale, clipped)
+    }
+
+    /// What the wheels do with `forces` (left, right) from `speeds` (at the start of the step):
+    /// with the grip for them, the slip and the heading now.
+    fn report(
+        &self,
+        k: &Kinematics,
+        (forces, speeds): ([f64; 2], [f64; 2]),
+        scale: f64,
+        clipped: bool,
+    ) -> Wheels {
         Wheels {
             forces,
             speeds,
-            lateral_force: self.grip_force(&k, forces),
-            slip: k.velocity.dot(&n),
+            lateral_force: self.grip_force(k, forces),
+            slip: k.velocity.dot(&k.normal()),
             scale,
             clipped,
             heading: (k.theta, k.omega),
@@ -274,15 +293,7 @@ impl DriveBody {
         let u = k.velocity.dot(&h);
         let speeds = [u - k.omega * s / 2.0, u + k.omega * s / 2.0];
         let (forces, scale) = self.forces_for(&k, targets);
-        Wheels {
-            forces,
-            speeds,
-            lateral_force: self.grip_force(&k, forces),
-            slip: k.velocity.dot(&n),
-            scale,
-            clipped: false,
-            heading: (k.theta, k.omega),
-        }
+        self.report(&k, (forces, speeds), scale, false)
     }
 
     /// The wheels' forces (left, right) that bring their speeds to `targets` (m/s) at the end

@@ -62,7 +62,7 @@ pub fn insert_agent(
         let (s, c) = agent.heading.sin_cos();
         let axle = [agent.start[0] - l * c, agent.start[1] - l * s];
         let r = drive.body_radius;
-        let inertia = agent.inertia.unwrap_or(0.5 * agent.mass * r * r);
+        let inertia = super::drive::DriveBody::inertia_of(agent);
         let body = RigidBodyBuilder::dynamic()
             .translation(Vector::new(axle[0] as f32, axle[1] as f32))
             .rotation(agent.heading as f32)
