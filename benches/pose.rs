@@ -30,12 +30,7 @@ fn fields(c: &mut Criterion) {
 fn joint_masks(c: &mut Criterion) {
     let mut group = c.benchmark_group("joint-mask");
     group.sample_size(10);
-    let link = |length: f64| Link {
-        length,
-        mass: 1.0,
-        com: 0.5 * length,
-        radius: 0.05,
-    };
+    let link = |length: f64| Link::rod(length, 1.0, 0.05);
     let walls: Vec<_> = [
         Wall::Box {
             center: [3.0, 2.4],

@@ -113,7 +113,7 @@ fn four_arrays(
 /// ```
 /// use nadf::field::{JointAxis, JointField, JointMask, JointTarget, export};
 /// use nadf::world::{Chain, Link};
-/// let link = |length: f64| Link { length, mass: 1.0, com: 0.5 * length, radius: 0.05 };
+/// let link = |length: f64| Link::rod(length, 1.0, 0.05);
 /// let chain = Chain { base: [2.0, 2.0], links: vec![link(1.0), link(0.8)] };
 /// let axis = JointAxis { cells: 16, limits: None };
 /// let mask = JointMask::build(&chain, &[axis, axis], &[], ([0.0, 0.0], [4.0, 4.0]));

@@ -296,7 +296,7 @@ impl JointField {
     /// ```
     /// use nadf::field::{JointAxis, JointField, JointMask, JointTarget};
     /// use nadf::world::{Chain, Link};
-    /// let link = |length: f64| Link { length, mass: 1.0, com: 0.5 * length, radius: 0.05 };
+    /// let link = |length: f64| Link::rod(length, 1.0, 0.05);
     /// let chain = Chain { base: [2.0, 2.0], links: vec![link(1.0), link(0.8)] };
     /// let axis = JointAxis { cells: 64, limits: None };
     /// let mask = JointMask::build(&chain, &[axis, axis], &[], ([0.0, 0.0], [4.0, 4.0]));
@@ -378,12 +378,7 @@ mod tests {
     use crate::world::{Link, Wall, wall_shape};
 
     fn link(length: f64) -> Link {
-        Link {
-            length,
-            mass: 1.0,
-            com: 0.5 * length,
-            radius: 0.05,
-        }
+        Link::rod(length, 1.0, 0.05)
     }
 
     /// A two-link arm on a table whose tip must reach round a post: the field has no local

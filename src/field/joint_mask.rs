@@ -251,12 +251,7 @@ mod tests {
     use crate::world::{Link, Wall, wall_shape};
 
     fn link(length: f64) -> Link {
-        Link {
-            length,
-            mass: 1.0,
-            com: 0.5 * length,
-            radius: 0.05,
-        }
+        Link::rod(length, 1.0, 0.05)
     }
 
     /// A three-link arm on a table between a post, a shelf and a disc.

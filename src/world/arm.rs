@@ -30,6 +30,22 @@ pub struct Link {
 }
 
 impl Link {
+    /// A link of `length` m and `mass` kg with its centre of mass at its middle, a capsule of
+    /// `radius` m.
+    ///
+    /// ```
+    /// let link = nadf::world::Link::rod(0.8, 1.0, 0.05);
+    /// assert_eq!(link.com, 0.4);
+    /// ```
+    pub fn rod(length: f64, mass: f64, radius: f64) -> Self {
+        Self {
+            length,
+            mass,
+            com: 0.5 * length,
+            radius,
+        }
+    }
+
     /// Its moment of inertia about its centre of mass, kg·m²: a uniform rod's.
     pub fn inertia(&self) -> f64 {
         self.mass * self.length * self.length / 12.0

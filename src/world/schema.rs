@@ -508,10 +508,8 @@ impl ArmSettings {
             base: self.base,
             links: (self.links.iter())
                 .map(|l| super::arm::Link {
-                    length: l.length,
-                    mass: l.mass,
                     com: l.com.unwrap_or(0.5 * l.length),
-                    radius: l.radius,
+                    ..super::arm::Link::rod(l.length, l.mass, l.radius)
                 })
                 .collect(),
         }
