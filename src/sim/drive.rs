@@ -242,19 +242,25 @@ impl DriveBody {
         }
     }
 
-    /// The grip for the wheels' `forces` (left, right): the sideways force that puts the
-    /// velocity at the end of the step along the heading at the end of the step (Rapier's
-    /// update: ω first, then the angle), at most `lateral_grip`.
-    fn grip_force(&self, k: &Kinematics, forces: [f64; 2]) -> f64 {
+    /// The wheels' `forces` (left, right) as their forward force `F`, N, their torque `τ`,
+    /// N·m, and the heading's normal at the end of the step (Rapier's update: ω first, then
+    /// the angle), where the grip acts.
+    fn push_of(&self, k: &Kinematics, forces: [f64; 2]) -> (f64, f64, Vector2<f64>) {
         let (f, t) = (
             forces[0] + forces[1],
             (forces[1] - forces[0]) * self.separation / 2.0,
         );
-        let dt = self.dt;
-        let theta_end = k.theta + dt * (k.omega + dt * t / self.inertia);
-        let n_end = Vector2::new(-theta_end.sin(), theta_end.cos());
-        let before = k.velocity + (k.heading() * f / self.mass + self.gravity) * dt;
-        let lateral = -self.mass * before.dot(&n_end) / dt;
+        let theta_end = k.theta + self.dt * (k.omega + self.dt * t / self.inertia);
+        (f, t, Vector2::new(-theta_end.sin(), theta_end.cos()))
+    }
+
+    /// The grip for the wheels' `forces` (left, right): the sideways force that puts the
+    /// velocity at the end of the step along the heading at the end of the step, at most
+    /// `lateral_grip`.
+    fn grip_force(&self, k: &Kinematics, forces: [f64; 2]) -> f64 {
+        let (f, _, n_end) = self.push_of(k, forces);
+        let before = k.velocity + (k.heading() * f / self.mass + self.gravity) * self.dt;
+        let lateral = -self.mass * before.dot(&n_end) / self.dt;
         self.grip.map_or(lateral, |grip| lateral.clamp(-grip, grip))
     }
 
@@ -335,14 +341,8 @@ impl DriveBody {
     /// Applies `wheels` (and the grip) for the next step, after resetting the body's forces.
     pub fn apply(&self, physics: &mut PhysicsWorld, wheels: &Wheels) {
         let k = self.kinematics(physics);
-        let h = k.heading();
-        let (f, t) = (
-            wheels.forces[0] + wheels.forces[1],
-            (wheels.forces[1] - wheels.forces[0]) * self.separation / 2.0,
-        );
-        let theta_end = k.theta + self.dt * (k.omega + self.dt * t / self.inertia);
-        let n_end = Vector2::new(-theta_end.sin(), theta_end.cos());
-        let total = h * f + n_end * wheels.lateral_force;
+        let (f, t, n_end) = self.push_of(&k, wheels.forces);
+        let total = k.heading() * f + n_end * wheels.lateral_force;
         let body = &mut physics.bodies[self.handle];
         body.reset_forces(false);
         body.reset_torques(false);
