@@ -41,7 +41,7 @@ fn main() {
         "{}: contacts {}, min clearance {:.3} m, settling time {:?} s",
         world.name(),
         robot.contacts,
-        robot.min_clearance,
+        robot.min_clearance.unwrap_or(f64::INFINITY),
         robot.settling_time
     );
     let first_ten = corridor(&["duration=10"]);
@@ -60,7 +60,11 @@ mod tests {
         let world = corridor(&["duration=20"]);
         let robot = &run(&world, &RunOptions::default()).unwrap().agents[0];
         assert_eq!(robot.contacts, 0);
-        assert!(robot.min_clearance > 0.05, "{}", robot.min_clearance);
+        assert!(
+            robot.min_clearance.is_some_and(|c| c > 0.05),
+            "{:?}",
+            robot.min_clearance
+        );
         assert!(robot.faults.is_clean(), "{:?}", robot.faults);
     }
 

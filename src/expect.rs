@@ -316,7 +316,7 @@ mod tests {
             settling_time: Some(5.0),
             final_error: 0.01,
             contacts: 0,
-            min_clearance: 0.3,
+            min_clearance: Some(0.3),
             max_deviation: 0.2,
             path_length: 10.0,
             peak_force: 30.0,
@@ -333,6 +333,7 @@ mod tests {
             intractable: None,
             map_seen: None,
             kinematic_length: None,
+            envelope_time: 0.0,
             faults: crate::metrics::Faults::default(),
         }
     }

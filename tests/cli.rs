@@ -320,6 +320,46 @@ fn check_accepts_every_shipped_world() {
     }
 }
 
+/// A door 0.7 m wide for a 0.6 m robot leaves 0.1 m of free configuration space, two cells of
+/// 0.05 m: `nadf check` warns of it, where it is; the paper's room has no such passage.
+#[test]
+fn check_warns_of_a_narrow_passage_on_the_kinematic_path_and_where_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let door = dir.path().join("door.toml");
+    std::fs::write(
+        &door,
+        "size = [6.0, 4.0]\n\
+         [[walls]]\nshape = \"box\"\ncenter = [3.0, 0.825]\nhalf_extents = [0.1, 0.825]\n\
+         [[walls]]\nshape = \"box\"\ncenter = [3.0, 3.175]\nhalf_extents = [0.1, 0.825]\n\
+         [[agents]]\nname = \"robot\"\nstart = [1.0, 2.0]\ntarget = [5.0, 2.0]\nradius = 0.3\n\
+         controller = { kind = \"nadf\", b = 10.0 }\n",
+    )
+    .unwrap();
+    let out = Command::new(nadf_bin())
+        .arg("check")
+        .arg(&door)
+        .arg(world_path("room-two-dividers.toml"))
+        .output()
+        .unwrap();
+    common::assert_success(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let warnings: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.contains("narrow passage"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{stdout}");
+    assert!(warnings[0].contains("door.toml"), "{stdout}");
+    // Where: in the door (its wall is 0.2 m thick at x = 3 m).
+    let at = warnings[0].split("passes [").nth(1).unwrap();
+    let (x, y) = at.split_once(", ").unwrap();
+    let x: f64 = x.parse().unwrap();
+    assert!(
+        (2.8..=3.2).contains(&x) && y.starts_with("2.00] m"),
+        "{stdout}"
+    );
+    assert!(warnings[0].contains("2.0 field cells"), "{stdout}");
+}
+
 #[test]
 fn check_names_the_file_line_and_key_of_every_problem_and_fails() {
     let dir = tempfile::tempdir().unwrap();

@@ -53,7 +53,10 @@ fn every_wheeled_world_reaches_untouched_within_the_wheels_limits() {
             let label = format!("{name} (unicycle: {unicycle})");
             println!("{label}: {agent:?}\n{wheels:?}");
             assert!(agent.reached && agent.contacts == 0, "{label}: {agent:?}");
-            assert!(agent.min_clearance > 0.0, "{label}: {agent:?}");
+            assert!(
+                agent.min_clearance.is_some_and(|c| c > 0.0),
+                "{label}: {agent:?}"
+            );
             assert!(
                 wheels.peak_wheel_speed <= speed * (1.0 + 1e-4),
                 "{label}: {wheels:?}"

@@ -27,7 +27,7 @@ fn run_file(path: &std::path::Path, overrides: &[&str], recording: Option<PathBu
     let summary = run(&world, &options).unwrap().agents.remove(0);
     for value in [
         summary.final_error,
-        summary.min_clearance,
+        summary.min_clearance.unwrap_or(0.0),
         summary.max_deviation,
         summary.path_length,
         summary.peak_force,

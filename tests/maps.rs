@@ -61,14 +61,20 @@ fn a_ros_map_keeps_its_origin_and_its_unknown_space_is_blocked_by_default() {
 }
 
 /// The measured problem: NADF alone crosses the arena at speed and overshoots the corner target
-/// into the walls; the braking envelope stops it on the target without a touch.
+/// into the walls; the clearance envelope keeps it off them, and the braking envelope stops it
+/// on the target.
 #[test]
-fn a_corner_target_is_reached_without_a_touch_only_with_the_braking_envelope() {
-    let mut world = common::world("map-arena.toml", &[]);
+fn a_corner_target_is_reached_without_a_touch_only_with_an_envelope() {
+    let mut world = common::world("map-arena.toml", &["agents.0.controller.envelope=false"]);
     world.agents[0].controller.brake = None;
     let without = common::summary_of(&world);
     assert!(without.contacts > 0, "{without:?}");
     assert!(without.peak_speed > 8.0, "{without:?}");
+    world.agents[0].controller.envelope = true;
+    let clear = common::summary_of(&world);
+    assert!(clear.reached && clear.contacts == 0, "{clear:?}");
+    assert!(clear.envelope_time > 0.0, "{clear:?}");
+    assert!(clear.min_clearance.is_some_and(|c| c > 0.0), "{clear:?}");
     let with = common::summary("map-arena.toml", &[]);
     assert!(with.reached, "{with:?}");
     assert_eq!(with.contacts, 0, "{with:?}");

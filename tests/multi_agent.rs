@@ -28,19 +28,31 @@ fn nadf_swaps_two_robots_without_contact_in_under_half_the_viscous_time() {
 fn without_replanning_the_robots_run_into_each_other_and_it_counts() {
     // Solved once at the start, robot 2 sits on robot 1's target and is left out of its field
     // (and the other way round): both head straight for each other.
-    let world = common::world(
-        "swap.toml",
-        &[
-            "field.replan_hz=0",
-            "agents.0.start=[2.0,7.0]",
-            "agents.0.target=[12.0,7.0]",
-            "agents.1.start=[12.0,7.0]",
-            "agents.1.target=[2.0,7.0]",
-        ],
-    );
-    let report = nadf::run::run(&world, &Default::default()).unwrap();
+    let head_on = [
+        "field.replan_hz=0",
+        "agents.0.start=[2.0,7.0]",
+        "agents.0.target=[12.0,7.0]",
+        "agents.1.start=[12.0,7.0]",
+        "agents.1.target=[2.0,7.0]",
+    ];
+    let bare: Vec<&str> = (head_on.iter().copied())
+        .chain([
+            "agents.0.controller.envelope=false",
+            "agents.1.controller.envelope=false",
+        ])
+        .collect();
+    let report = nadf::run::run(&common::world("swap.toml", &bare), &Default::default()).unwrap();
     for s in &report.agents {
         assert!(s.contacts >= 1, "{s:?}");
+    }
+    // The clearance envelope stops them apart: blind to each other, they stay stuck there
+    // (and say so), but they do not touch.
+    let world = common::world("swap.toml", &head_on);
+    let report = nadf::run::run(&world, &Default::default()).unwrap();
+    for s in &report.agents {
+        assert_eq!(s.contacts, 0, "{s:?}");
+        assert!(s.min_separation.is_some_and(|d| d > 0.0), "{s:?}");
+        assert!(s.deadlocked.is_some(), "{s:?}");
     }
 }
 

@@ -4,7 +4,13 @@
 
 mod common;
 
-use common::summary;
+/// The paper's law bare: the clearance envelope is the sandbox's, not the paper's.
+const BARE: &str = "agents.0.controller.envelope=false";
+
+fn summary(world: &str, overrides: &[&str]) -> nadf::metrics::Summary {
+    let overrides: Vec<&str> = overrides.iter().copied().chain([BARE]).collect();
+    common::summary(world, &overrides)
+}
 
 const NADF: &str = "room-two-dividers-gradient.toml";
 const VISCOUS: &str = "room-two-dividers-gradient-viscous.toml";

@@ -13,6 +13,8 @@ fn with(kind: &str, b: f64) -> nadf::metrics::Summary {
         &[
             &format!("agents.0.controller.kind={kind}"),
             &format!("agents.0.controller.b={b}"),
+            // The paper's laws bare: the clearance envelope would keep even B = 0.1 clear.
+            "agents.0.controller.envelope=false",
             // Long enough for the slowest viscous case to settle.
             "duration=120",
         ],
@@ -23,14 +25,19 @@ fn with(kind: &str, b: f64) -> nadf::metrics::Summary {
 fn viscous_b_0_1_hits_a_wall() {
     let s = with("viscous", 0.1);
     assert!(s.contacts > 0, "{s:?}");
-    assert_eq!(s.min_clearance, 0.0, "{s:?}");
+    // Rapier holds it off the wall, within the contact tolerance.
+    let tolerance = nadf::sim::CONTACT_TOLERANCE;
+    assert!(s.min_clearance.is_some_and(|c| c < tolerance), "{s:?}");
 }
 
 #[test]
 fn viscous_b_0_7_reaches_the_target_without_contact() {
     let s = with("viscous", 0.7);
     assert_eq!(s.contacts, 0, "{s:?}");
-    assert!(s.reached && s.min_clearance > 0.0, "{s:?}");
+    assert!(
+        s.reached && s.min_clearance.is_some_and(|c| c > 0.0),
+        "{s:?}"
+    );
 }
 
 #[test]

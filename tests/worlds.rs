@@ -92,6 +92,15 @@ fn every_shipped_world_meets_its_expectations() {
                 assert_eq!(faults[key], 0, "{}: {faults}", path.display());
             }
             assert_eq!(faults["non_finite_state"], false);
+            // A body at or inside a wall or another body touched it: counted, always.
+            let touched = |key: &str| agent[key].as_f64().is_some_and(|d| d <= 0.0);
+            if touched("min_clearance") || touched("min_separation") {
+                assert!(
+                    agent["contacts"].as_u64() > Some(0),
+                    "{}: {agent}",
+                    path.display()
+                );
+            }
         }
     }
 }

@@ -4,8 +4,15 @@ use std::path::PathBuf;
 
 use super::{Failure, load};
 use crate::field::FreeSpace;
-use crate::sim::Simulation;
+use crate::sim::{Simulation, WallIndex};
 use crate::world::SensorKind;
+use nalgebra::Vector2;
+
+/// A passage on an agent's kinematic path is narrow when it leaves the body's centre less than
+/// twice this many field cells of free configuration space across the path (measured on the
+/// rooms map: its one-cell doors leave 0.4 m free to a 0.3 m robot, two cells at 0.2 m, and
+/// NADF crosses them only by touching without the envelope).
+pub const NARROW_CELLS: f64 = 1.5;
 
 /// The arguments of `nadf check`.
 #[derive(Debug, Clone, clap::Args)]
@@ -29,10 +36,12 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
             }
         };
         let mut intractable = FreeSpace::intractable(&world);
-        if intractable.is_empty()
-            && let Err(e) = Simulation::new(&world)
-        {
-            intractable.push(e);
+        let mut narrow = Vec::new();
+        if intractable.is_empty() {
+            match Simulation::new(&world) {
+                Ok(sim) => narrow = narrow_passages(&sim),
+                Err(e) => intractable.push(e),
+            }
         }
         if intractable.is_empty() {
             // The bodies it holds, by kind (agents, discs or shapes, always).
@@ -51,6 +60,9 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
                 world.name(),
                 world.walls.len()
             );
+            for warning in &narrow {
+                println!("{}: warning: {warning}", path.display());
+            }
             // A lidar agent is not refused (it must find out online), but the user is told.
             for agent in world
                 .agents
@@ -78,4 +90,65 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
     } else {
         Err(Failure::BadInput(problems.join("\n")))
     }
+}
+
+/// The narrow passages on each disc agent's kinematic path ([`NARROW_CELLS`]), one message per
+/// passage at its narrowest point: where, and how much free configuration space it leaves
+/// across the path (the room the body's centre has to either side of it, out to a few cells).
+/// Robots on wheels are left out: their path is their look-ahead point's, not their footprint's.
+pub fn narrow_passages(sim: &Simulation) -> Vec<String> {
+    let cell = sim.world.field.cell;
+    let index = WallIndex::new(&sim.walls);
+    let limit = 2.0 * NARROW_CELLS * cell;
+    let mut out = Vec::new();
+    for run in sim.agents.iter().filter(|a| a.agent.drive.is_none()) {
+        let r = run.agent.radius;
+        let free = |p: Vector2<f64>| index.signed_clearance(&sim.walls, p, r) > 0.0;
+        // How far the centre can move from `p` along `n` and stay free, up to the limit.
+        let room = |p: Vector2<f64>, n: Vector2<f64>| {
+            let steps = 8.0 * 2.0 * NARROW_CELLS;
+            (1..=steps as usize)
+                .map(|k| k as f64 * limit / steps)
+                .take_while(|&s| free(p + n * s))
+                .last()
+                .unwrap_or(0.0)
+        };
+        // Each run of narrow points along the path, by its narrowest point.
+        let mut passages: Vec<([f64; 2], f64)> = Vec::new();
+        let mut current: Option<([f64; 2], f64)> = None;
+        for pair in run.kinematic.points.windows(2) {
+            let (a, b) = (Vector2::from(pair[0]), Vector2::from(pair[1]));
+            let Some(t) = (b - a).try_normalize(0.0) else {
+                continue;
+            };
+            let n = Vector2::new(-t.y, t.x);
+            let width = room(a, n) + room(a, -n);
+            if width < limit && free(a) {
+                if current.is_none_or(|(_, narrowest)| width < narrowest) {
+                    current = Some((pair[0], width));
+                }
+            } else if let Some(found) = current.take() {
+                passages.push(found);
+            }
+        }
+        passages.extend(current);
+        let Some(&(at, width)) = passages.iter().min_by(|a, b| a.1.total_cmp(&b.1)) else {
+            continue;
+        };
+        let more = match passages.len() {
+            1 => String::new(),
+            n => format!(" (the narrowest of {n} such stretches)"),
+        };
+        out.push(format!(
+            "a narrow passage: `{}`'s kinematic path passes [{:.2}, {:.2}] m with {:.3} m of free configuration space across it{more}, {:.1} field cells of {cell} m, which the field resolves coarsely and a body crosses with little room; a `field.cell` of {:.3} m resolves it in {} cells",
+            run.agent.name,
+            at[0],
+            at[1],
+            width,
+            width / cell,
+            width / (2.0 * NARROW_CELLS),
+            2.0 * NARROW_CELLS
+        ));
+    }
+    out
 }

@@ -8,12 +8,14 @@
 //! eq. 72–73), the clamping control ([`Clamp`], eq. 35) and, for the pendulum, a plain spring
 //! ([`Spring`], eq. 75). A [`Controller`] sums its laws
 //! (eq. 36: `F = -B_d M - K ∇V - K_c F_c`), adds the iterative bias ([`Bias`], eq. 48–50) and
-//! applies the speed limit ([`SpeedLimit`], §VI.2) last. The linear parts of the laws (the
+//! applies the speed limit ([`SpeedLimit`], §VI.2) last; the clearance envelope
+//! ([`Envelope`]) then keeps a disc's force within what it can stop from in the room ahead. The linear parts of the laws (the
 //! damping and the clamp's or spring's stiffness) are integrated exactly over each step
 //! ([`Integrator`]), so that no gain is unstable.
 
 mod bias;
 mod clamp;
+mod envelope;
 mod guidance;
 mod integrator;
 mod nadf;
@@ -25,6 +27,7 @@ mod viscous;
 
 pub use bias::{Bias, CONVERGED};
 pub use clamp::Clamp;
+pub use envelope::{Envelope, Enveloped, MARGIN as ENVELOPE_MARGIN, Step, Sweep};
 pub use guidance::{Guidance, GuidanceMode};
 pub use integrator::{Integrator, Split, phi, positive_part};
 pub use nadf::{Nadf, step};
@@ -275,6 +278,8 @@ mod tests {
             integration: Integration::Exact,
             orca: None,
             turn_gain: None,
+            envelope: true,
+            envelope_damping: None,
         }
     }
 

@@ -59,8 +59,10 @@ crate::measured! {
         pub final_error: f64 [unit("m"), column("error_m")],
         /// Number of contact starts.
         pub contacts: usize [column("contacts")],
-        /// Smallest distance from the agent's shape to any wall, m.
-        pub min_clearance: f64 [unit("m"), column("clear_m")],
+        /// Smallest signed distance from the agent's shape to any wall after a step, m:
+        /// negative by the depth when it overlapped one (always counted as a contact); `None`
+        /// in a world without walls.
+        pub min_clearance: Option<f64> [unit("m"), column("clear_m"), missing("no walls")],
         /// `δ_m`: largest distance from the dynamic to the kinematic path, m.
         pub max_deviation: f64 [unit("m"), column("dev_m")],
         /// Length of the dynamic path, m.
@@ -102,6 +104,9 @@ crate::measured! {
         /// The length of the kinematic path (with full knowledge of the walls), m; `None` when
         /// it does not reach the target.
         pub kinematic_length: Option<f64> [unit("m"), digits(2), missing("no path")],
+        /// How long the clearance envelope changed the control force, s (0 when it never
+        /// bound, or the envelope is off).
+        pub envelope_time: f64 [unit("s"), column("env_s")],
         /// Numerical faults met during the run (all zero in a healthy run).
         pub faults: Faults,
     }
@@ -146,6 +151,7 @@ pub struct Metrics {
     final_distance: f64,
     contacts: usize,
     min_clearance: f64,
+    envelope_time: f64,
     path: Vec<[f64; 2]>,
     path_length: f64,
     peak_force: f64,
@@ -191,6 +197,7 @@ impl Metrics {
             final_distance: d0,
             contacts: 0,
             min_clearance: f64::INFINITY,
+            envelope_time: 0.0,
             path: vec![start.into()],
             path_length: 0.0,
             peak_force: 0.0,
@@ -266,6 +273,11 @@ impl Metrics {
         }
     }
 
+    /// Counts a step of `dt` (s) in which the clearance envelope changed the control force.
+    pub fn record_envelope(&mut self, dt: f64) {
+        self.envelope_time += dt;
+    }
+
     /// Counts `n` new contact starts.
     pub fn record_contacts(&mut self, n: usize) {
         self.contacts += n;
@@ -315,11 +327,8 @@ impl Metrics {
             settling_time: if reached { self.settled_at } else { None },
             final_error: self.final_distance,
             contacts: self.contacts,
-            min_clearance: if self.min_clearance.is_finite() {
-                self.min_clearance
-            } else {
-                0.0
-            },
+            min_clearance: self.min_clearance.is_finite().then_some(self.min_clearance),
+            envelope_time: self.envelope_time,
             max_deviation,
             path_length: self.path_length,
             peak_force: self.peak_force,
@@ -380,7 +389,7 @@ mod tests {
         assert_eq!(s.settling_time, None);
         assert_eq!(s.max_deviation, 1.0);
         assert_eq!(s.peak_speed, 5.0);
-        assert_eq!(s.min_clearance, 0.2);
+        assert_eq!(s.min_clearance, Some(0.2));
     }
 
     #[test]

@@ -162,12 +162,17 @@ pub fn world_of(experiment: &Experiment) -> Result<World, ReproduceError> {
         .iter()
         .map(|o| o.parse::<Override>().map_err(|e| bad(e.to_string())))
         .collect::<Result<Vec<_>, _>>()?;
-    load_str(
+    let mut world = load_str(
         text,
         &Path::new("worlds").join(experiment.world),
         &overrides,
     )
-    .map_err(|e| bad(e.to_string()))
+    .map_err(|e| bad(e.to_string()))?;
+    // The paper's laws bare: the clearance envelope is the sandbox's, not the paper's.
+    for agent in &mut world.agents {
+        agent.controller.envelope = false;
+    }
+    Ok(world)
 }
 
 /// Runs one experiment step by step, keeping every step.

@@ -17,12 +17,20 @@ const SCAN: usize = 64;
 /// (a box test each, a distance query only for the walls whose box is nearer than the nearest
 /// so far).
 pub fn signed_clearance(walls: &[WallShape], position: Vector2<f64>, radius: f64) -> f64 {
+    nearest_wall(walls, position, radius).0
+}
+
+/// [`signed_clearance`] and the index of the wall that gives it (`None` without walls).
+fn nearest_wall(walls: &[WallShape], position: Vector2<f64>, radius: f64) -> (f64, Option<usize>) {
     let (x, y) = (position.x, position.y);
-    let mut nearest = f64::INFINITY;
-    for w in walls {
-        nearest = nearer(w, x, y, nearest);
+    let (mut nearest, mut which) = (f64::INFINITY, None);
+    for (k, w) in walls.iter().enumerate() {
+        let d = nearer(w, x, y, nearest);
+        if d < nearest {
+            (nearest, which) = (d, Some(k));
+        }
     }
-    nearest - radius
+    (nearest - radius, which)
 }
 
 /// The smaller of `nearest` and the signed distance from `(x, y)` to `w`, measuring the latter
@@ -67,11 +75,30 @@ impl WallIndex {
         position: Vector2<f64>,
         radius: f64,
     ) -> f64 {
+        self.nearest_wall(walls, position, radius).0
+    }
+
+    /// [`WallIndex::signed_clearance`] and the index of the wall that gives it (`None`
+    /// without walls).
+    pub fn nearest_wall(
+        &self,
+        walls: &[WallShape],
+        position: Vector2<f64>,
+        radius: f64,
+    ) -> (f64, Option<usize>) {
         let Some(buckets) = &self.0 else {
-            return signed_clearance(walls, position, radius);
+            return nearest_wall(walls, position, radius);
         };
         let (x, y) = (position.x, position.y);
-        buckets.nearest([x, y], |k, best| nearer(&walls[k], x, y, best)) - radius
+        let mut which = None;
+        let nearest = buckets.nearest([x, y], |k, best| {
+            let d = nearer(&walls[k], x, y, best);
+            if d < best {
+                which = Some(k);
+            }
+            d
+        });
+        (nearest - radius, which)
     }
 }
 

@@ -68,6 +68,8 @@ pub struct Simulation {
     pub walls: Vec<WallShape>,
     /// The walls by bucket, for the clearance after every step.
     index: WallIndex,
+    /// The walls' colliders, in the order of `walls`.
+    wall_colliders: Vec<rapier2d::prelude::ColliderHandle>,
     /// The agents.
     pub agents: Vec<AgentRun>,
     /// The pendulums.
@@ -91,7 +93,7 @@ impl Simulation {
     pub fn new(world: &World) -> Result<Self, FieldError> {
         let mut physics = physics::empty_world(world.dt, world.external_acceleration);
         let walls = all_wall_shapes(world);
-        physics::insert_walls(&mut physics, &walls);
+        let wall_colliders = physics::insert_walls(&mut physics, &walls);
         let starts: Vec<Disc> = world
             .agents
             .iter()
@@ -120,15 +122,16 @@ impl Simulation {
         let arms = (0..world.arms.len())
             .map(|index| arm_run::ArmRun::new(world, index, &mut physics, &walls))
             .collect::<Result<_, _>>()?;
-        if agents.iter().any(|a| a.lidar.is_some()) {
-            // Rapier fills its scene-query structure during a step; a lidar scans before the
-            // first one, and would see through every wall.
+        if agents.iter().any(|a| a.lidar.is_some() || a.has_envelope()) {
+            // Rapier fills its scene-query structure during a step; a lidar scans (and the
+            // envelope casts) before the first one, and would see through every wall.
             physics.detect_collisions(&(), &());
         }
         Ok(Self {
             world: world.clone(),
             index: WallIndex::new(&walls),
             walls,
+            wall_colliders,
             agents,
             pendulums,
             shaped,
@@ -166,8 +169,15 @@ impl Simulation {
         let solved: Vec<_> = (self.agents.par_iter().zip(&plans))
             .map(|(agent, plan)| agent.resolve(plan, &self.world))
             .collect();
-        for ((agent, plan), solved) in self.agents.iter_mut().zip(plans).zip(solved) {
-            agent.apply(plan, solved, &mut self.physics, self.world.dt);
+        // The envelope decides in the agents' order: each one's sweep is clear of the ones
+        // before it as they have just chosen and of the ones after it as they were.
+        let step = physics::step_of(&self.physics, self.world.dt);
+        let mut sweeps: Vec<_> = (self.agents.iter().zip(&plans))
+            .map(|(agent, plan)| agent.sweep(plan, step))
+            .collect();
+        let applied = self.agents.iter_mut().zip(plans).zip(solved);
+        for (index, ((agent, plan), solved)) in applied.enumerate() {
+            agent.apply(plan, solved, &mut self.physics, step, (&mut sweeps, index));
         }
         for p in &mut self.pendulums {
             p.apply(&mut self.physics, self.time, self.world.dt);
@@ -190,7 +200,11 @@ impl Simulation {
         for a in &mut self.arms {
             a.observe(&self.physics, self.time, &self.walls);
         }
-        let walls = (self.walls.as_slice(), &self.index);
+        let walls = (
+            self.walls.as_slice(),
+            &self.index,
+            self.wall_colliders.as_slice(),
+        );
         let bounds = self.world.bounds();
         let mut states: Vec<AgentState> = (self.agents.iter_mut())
             .map(|a| a.observe(&self.physics, self.time, walls, bounds))

@@ -2,8 +2,11 @@
 //! laws' nalgebra `f64` vectors and Rapier's `glam` `f32` ones.
 
 use nalgebra::Vector2;
+use rapier2d::parry::query::ShapeCastOptions;
+use rapier2d::parry::shape::Ball;
 use rapier2d::prelude::*;
 
+use crate::control::{ENVELOPE_MARGIN, Step, Sweep};
 use crate::world::{Agent, WallShape};
 
 /// Rapier vector → control-law vector.
@@ -26,6 +29,11 @@ pub fn empty_world(dt: f64, external_acceleration: [f64; 2]) -> PhysicsWorld {
         ),
         integration_parameters: IntegrationParameters {
             dt: dt as f32,
+            // Rapier keeps a pair's contacts (and their distances) while the pair has moved
+            // less than 5 cm since its last full update: a body creeping into a wall would be
+            // reported at the distance it had when it was still clear (measured: a touch that
+            // counted no contact). Every contact is recomputed every step instead.
+            contact_recycling: false,
             ..IntegrationParameters::default()
         },
         ..PhysicsWorld::default()
@@ -91,4 +99,69 @@ pub fn insert_agent(
         .friction(0.0)
         .restitution(0.0);
     physics.insert(body, collider)
+}
+
+/// How Rapier moves a body over a step of `dt` (s) in `physics` (see [`Step`]): its substeps,
+/// one per solver iteration, each add `1/N` of the step's change of velocity.
+pub fn step_of(physics: &PhysicsWorld, dt: f64) -> Step {
+    let n = physics.integration_parameters.num_solver_iterations.max(1) as f64;
+    Step {
+        dt,
+        blend: (n + 1.0) / (2.0 * n),
+    }
+}
+
+/// Whether `sweep` keeps the envelope's margin from every wall (Rapier's fixed colliders):
+/// its disc cast along each of its segments. A disc already that near and moving away is
+/// clear.
+pub fn clear_of_walls(physics: &PhysicsWorld, sweep: &Sweep) -> bool {
+    let ball = Ball::new(sweep.radius as f32);
+    sweep.segments().iter().all(|&(from, to)| {
+        let length = (to - from).norm();
+        if length <= 0.0 || length.is_nan() {
+            return true;
+        }
+        let options = ShapeCastOptions {
+            max_time_of_impact: length as f32,
+            target_distance: ENVELOPE_MARGIN as f32,
+            stop_at_penetration: false,
+            compute_impact_geometry_on_penetration: false,
+        };
+        let hit = physics.cast_shape(
+            &Pose::from_translation(to_rapier(from)),
+            to_rapier((to - from) / length),
+            &ball,
+            options,
+            QueryFilter::only_fixed(),
+        );
+        hit.is_none()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The envelope's model of a step is what Rapier does: a free ball pushed sideways while
+    /// moving moves by `dt (v + c (v⁺ − v))`.
+    #[test]
+    fn a_step_moves_a_body_as_the_envelope_assumes() {
+        let dt = 0.01;
+        let mut physics = empty_world(dt, [0.0, 0.0]);
+        let text = "size = [10.0, 10.0]\n[[agents]]\nname = \"a\"\nstart = [5.0, 5.0]\n\
+                    target = [8.0, 5.0]\ninitial_velocity = [3.0, 0.0]\n\
+                    controller = { kind = \"nadf\", b = 1.0 }\n";
+        let world = crate::world::load_str(text, std::path::Path::new("w.toml"), &[]).unwrap();
+        let agent = &world.agents[0];
+        let (body, _) = insert_agent(&mut physics, agent);
+        let force = Vector2::new(-40.0, 25.0);
+        physics.bodies[body].add_force(to_rapier(force), true);
+        physics.step();
+        let b = &physics.bodies[body];
+        let (x, v) = (from_rapier(b.translation()), from_rapier(b.linvel()));
+        let v0 = Vector2::new(3.0, 0.0);
+        assert!((v - (v0 + force / agent.mass * dt)).norm() < 1e-5, "{v}");
+        let moved = step_of(&physics, dt).moved(Vector2::new(5.0, 5.0), v0, v);
+        assert!((x - moved).norm() < 1e-6, "{x} vs {moved}");
+    }
 }

@@ -714,6 +714,18 @@ pub struct ControllerSettings {
     /// wheels' largest speed).
     #[serde(default)]
     pub turn_gain: Option<f64>,
+    /// The clearance envelope (`control::Envelope`, on by default): the body never moves
+    /// faster than it can stop, braking with `envelope_damping`, in the room it has ahead of
+    /// it to the walls and to the other agents' envelopes, so it touches neither. `false`
+    /// runs the law bare (the paper's own runs, which have no envelope). Not for robots on
+    /// wheels (their wheels limit them instead).
+    #[serde(default = "default_true")]
+    pub envelope: bool,
+    /// The envelope's braking damping `B_e`, N·s/m: it stops the body by damping its whole
+    /// velocity with it, within `m·v/B_e`. Default: the controller's damping (`b` for `nadf`
+    /// and `viscous`; `m/tracking_time` for `orca`; `f0/vd` for `sliding-mode`).
+    #[serde(default)]
+    pub envelope_damping: Option<f64>,
 }
 
 /// The `[agents.controller.orca]` table: optimal reciprocal collision avoidance's settings
@@ -773,6 +785,24 @@ impl ControllerSettings {
     /// The guidance gain K ([`DEFAULT_K`] unless given).
     pub fn k(&self) -> f64 {
         self.k.unwrap_or(DEFAULT_K)
+    }
+
+    /// The clearance envelope's braking damping `B_e` for a body of `mass` (kg), N·s/m: the
+    /// one given, else the controller's own damping; `None` when the envelope is off, the
+    /// controller is the unicycle law (its wheels limit it), or there is no damping to brake
+    /// with (`b = 0`: such a body cannot stop, and is left bare).
+    pub fn envelope_damping(&self, mass: f64) -> Option<f64> {
+        if !self.envelope {
+            return None;
+        }
+        self.envelope_damping
+            .or(match self.kind {
+                ControllerKind::Nadf | ControllerKind::Viscous => self.b,
+                ControllerKind::Orca => Some(mass / self.orca.unwrap_or_default().tracking_time),
+                ControllerKind::SlidingMode => self.f0.zip(self.vd).map(|(f0, vd)| f0 / vd),
+                ControllerKind::Unicycle => None,
+            })
+            .filter(|b| b.is_finite() && *b > 0.0)
     }
 }
 

@@ -689,6 +689,21 @@ fn check_controller(
     if let Some(k) = c.turn_gain {
         positive(bad, &key("turn_gain"), k);
     }
+    if let Some(b) = c.envelope_damping {
+        positive(bad, &key("envelope_damping"), b);
+        if !c.envelope {
+            bad(
+                key("envelope_damping"),
+                "is not used with envelope = false".into(),
+            );
+        }
+    }
+    if c.kind == ControllerKind::Unicycle && c.envelope_damping.is_some() {
+        bad(
+            key("envelope_damping"),
+            "is not used by kind = \"unicycle\" (its wheels limit it)".into(),
+        );
+    }
     if c.kind != ControllerKind::Orca && c.orca.is_some() {
         bad(key("orca"), format!("is not used by kind = \"{kind}\""));
     }
