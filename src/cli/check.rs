@@ -107,11 +107,26 @@ pub fn narrow_passages(sim: &Simulation) -> Vec<String> {
         // How far the centre can move from `p` along `n` and stay free, up to the limit.
         let room = |p: Vector2<f64>, n: Vector2<f64>| {
             let steps = 8.0 * 2.0 * NARROW_CELLS;
-            (1..=steps as usize)
-                .map(|k| k as f64 * limit / steps)
+            let h = limit / steps;
+            let last = (1..=steps as usize)
+                .map(|k| k as f64 * h)
                 .take_while(|&s| free(p + n * s))
                 .last()
-                .unwrap_or(0.0)
+                .unwrap_or(0.0);
+            if last + h > limit {
+                return last;
+            }
+            // The wall is within the next step: found to a thousandth of it.
+            let (mut lo, mut hi) = (last, last + h);
+            for _ in 0..10 {
+                let mid = 0.5 * (lo + hi);
+                if free(p + n * mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            lo
         };
         // Each run of narrow points along the path, by its narrowest point.
         let mut passages: Vec<([f64; 2], f64)> = Vec::new();

@@ -438,6 +438,11 @@ pub const AGENT_PLOTS: &[Plot<Agent, AgentState>] = &[
                 shown: |a| a.controller.speed_limit.is_some() || a.controller.brake.is_some(),
                 value: |_, s| flag(s.speed_limited),
             },
+            Series {
+                label: "clearance envelope active",
+                shown: |a| a.drive.is_none() && a.controller.envelope_damping(a.mass).is_some(),
+                value: |_, s| flag(s.enveloped),
+            },
         ],
     },
     Plot {
