@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use super::{Failure, load};
 use crate::field::FreeSpace;
-use crate::sim::{Simulation, WallIndex};
+use crate::sim::Simulation;
 use crate::world::SensorKind;
 use nalgebra::Vector2;
 
@@ -98,7 +98,7 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
 /// Robots on wheels are left out: their path is their look-ahead point's, not their footprint's.
 pub fn narrow_passages(sim: &Simulation) -> Vec<String> {
     let cell = sim.world.field.cell;
-    let index = WallIndex::new(&sim.walls);
+    let index = sim.wall_index();
     let limit = 2.0 * NARROW_CELLS * cell;
     let mut out = Vec::new();
     for run in sim.agents.iter().filter(|a| a.agent.drive.is_none()) {

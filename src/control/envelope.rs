@@ -194,11 +194,13 @@ impl Envelope {
         }
         // As fast as the room allows along the law's direction or one turned from it by up to
         // a right angle (zero is always clear), making the most headway along the law's...
+        // The force that takes the body from `v` to `u` over the step.
+        let force_to = |u: Vector2<f64>| m * ((u - v) / dt - external);
         let braked = v * self.retention(step);
-        let brake_force = m * ((braked - v) / dt - external);
+        let brake_force = force_to(braked);
         let budget = force.norm().max(brake_force.norm());
         let direction = next / speed;
-        let mut best: Option<(f64, Vector2<f64>)> = None;
+        let mut best: Option<(f64, Vector2<f64>, Vector2<f64>)> = None;
         for turn in TURNS {
             let (sin, cos) = turn.sin_cos();
             let d = Vector2::new(
@@ -214,17 +216,16 @@ impl Envelope {
                     hi = s;
                 }
             }
-            let cut = d * lo;
-            let headway = lo * cos;
-            let within = (m * ((cut - v) / dt - external)).norm() <= budget;
-            if within && best.is_none_or(|(h, _)| headway > h) {
-                best = Some((headway, cut));
+            let (cut, headway) = (d * lo, lo * cos);
+            let cut_force = force_to(cut);
+            if cut_force.norm() <= budget && best.is_none_or(|(h, ..)| headway > h) {
+                best = Some((headway, cut, cut_force));
             }
         }
         // ...or the braking, when no such turn is within the force.
         let (force, velocity) = match best {
-            Some((headway, cut)) if headway > 0.0 || brake_force.norm() >= budget => {
-                (m * ((cut - v) / dt - external), cut)
+            Some((headway, cut, cut_force)) if headway > 0.0 || brake_force.norm() >= budget => {
+                (cut_force, cut)
             }
             _ => (brake_force, braked),
         };

@@ -404,7 +404,11 @@ impl AgentRun {
             self.log.scan = Some(beams);
         }
         if self.orca.is_some() {
+            let grown = self.orca_growth(world.dt);
             plan.neighbours = others;
+            for n in &mut plan.neighbours {
+                n.radius += grown;
+            }
         } else {
             // Each other agent's disc is grown by how far it moves before the next replan, so
             // the field keeps the agent off where the other will be, not only where it is
@@ -509,15 +513,17 @@ impl AgentRun {
     pub(super) fn sweep(&self, plan: &Plan, step: Step) -> Sweep {
         match &self.envelope {
             Some(e) => e.remaining(plan.x, plan.v, step),
-            // Its disc moved on by its velocity for the step (a robot on wheels: the look-ahead
-            // point's disc, which holds its footprint).
-            None => {
-                let on = plan.x + plan.v * step.dt;
-                Sweep {
-                    points: [plan.x, on, on],
-                    radius: self.agent.radius,
-                }
-            }
+            None => self.bare_sweep(plan.x, plan.x + plan.v * step.dt),
+        }
+    }
+
+    /// The sweep of a body without an envelope from `x` to where its step takes it, `to`:
+    /// that one step, nothing after (a robot on wheels: the look-ahead point's disc, which
+    /// holds its footprint).
+    fn bare_sweep(&self, x: Vector2<f64>, to: Vector2<f64>) -> Sweep {
+        Sweep {
+            points: [x, to, to],
+            radius: self.agent.radius,
         }
     }
 
@@ -535,9 +541,8 @@ impl AgentRun {
         (sweeps, index): (&mut [Sweep], usize),
     ) {
         let dt = step.dt;
-        let (x0, plan_v) = (plan.x, plan.v);
+        let (x, v) = (plan.x, plan.v);
         if !self.frozen {
-            let (x, v) = (plan.x, plan.v);
             let neighbours = std::mem::take(&mut plan.neighbours);
             self.update_field(plan, solved);
             self.log.control = Some(self.control(x, v, dt, &neighbours));
@@ -558,7 +563,7 @@ impl AgentRun {
                 if c.kind == ControllerKind::Unicycle && !self.frozen =>
             {
                 // The peers' baseline commands the wheels itself, on the same field.
-                let x = x0 + self.position_error;
+                let x = x + self.position_error;
                 let guidance = self.field.gradient(x.into()).and_then(|g| unit(&-g));
                 let distance = (x - Vector2::from(self.agent.target)).norm();
                 let v_max = c.speed_limit.unwrap_or(drive.max_wheel_speed);
@@ -570,9 +575,8 @@ impl AgentRun {
             }
             _ => {
                 if let Some(envelope) = self.envelope.filter(|_| !self.frozen) {
-                    let state = (x0, plan_v);
                     let out =
-                        self.envelope(&envelope, physics, state, force, step, (sweeps, index));
+                        self.envelope(&envelope, physics, (x, v), force, step, (sweeps, index));
                     if out.bound {
                         self.log.enveloped = true;
                         self.metrics.record_envelope(dt);
@@ -583,12 +587,8 @@ impl AgentRun {
                     force = out.force;
                     sweeps[index] = out.sweep;
                 } else {
-                    let next = plan_v + (force / self.agent.mass + self.external) * dt;
-                    let moved = step.moved(x0, plan_v, next);
-                    sweeps[index] = Sweep {
-                        points: [x0, moved, moved],
-                        radius: self.agent.radius,
-                    };
+                    let next = v + (force / self.agent.mass + self.external) * dt;
+                    sweeps[index] = self.bare_sweep(x, step.moved(x, v, next));
                 }
                 self.log.wheels = self.body.actuate(physics, &force);
             }
@@ -769,16 +769,8 @@ impl AgentRun {
         neighbours: &[Neighbour],
     ) -> ControlOutput<2> {
         let x = x + self.position_error;
-        // Under the clearance envelope ORCA plans with every disc grown by one step at its top
-        // speed and the envelope's margin: its velocities graze the others (they lie on its
-        // constraints) in continuous time, and a graze that the discrete step overshoots is one
-        // the envelope stops. (Measured, 32 robots on 1.2 m of arc each: grown by the margin
-        // alone, 9 of 32 arrive, the rest jam; grown so, all 32 do, in 16.6 s.)
-        let grown = match (&self.envelope, &self.orca) {
-            (Some(_), Some(orca)) => orca.max_speed * dt + ENVELOPE_MARGIN,
-            _ => 0.0,
-        };
-        let (orca, radius) = (self.orca, self.agent.radius + grown);
+        // The neighbours were grown in `plan`.
+        let (orca, radius) = (self.orca, self.agent.radius + self.orca_growth(dt));
         let reference = |offset: &Vector2<f64>, gradient: Option<Vector2<f64>>| {
             orca.map(|orca| {
                 let me = Neighbour {
@@ -787,13 +779,7 @@ impl AgentRun {
                     radius,
                 };
                 let preferred = orca.preferred_velocity(gradient, *offset);
-                let others: Vec<Neighbour> = (neighbours.iter())
-                    .map(|n| Neighbour {
-                        radius: n.radius + grown,
-                        ..*n
-                    })
-                    .collect();
-                orca.velocity(&me, preferred, &others, dt)
+                orca.velocity(&me, preferred, neighbours, dt)
             })
         };
         let sensed = Sensed {
@@ -827,6 +813,19 @@ impl AgentRun {
         out
     }
 
+    /// How much ORCA grows every disc, its own and its neighbours', for steps of `dt` (s), m.
+    /// Under the clearance envelope: one step at its top speed and the envelope's margin. Its
+    /// velocities graze the others (they lie on its constraints) in continuous time, and a
+    /// graze that the discrete step overshoots is one the envelope stops. (Measured, 32 robots
+    /// on 1.2 m of arc each: grown by the margin alone, 9 of 32 arrive, the rest jam; grown so,
+    /// all 32 do, in 16.6 s.) Zero without the envelope or ORCA.
+    fn orca_growth(&self, dt: f64) -> f64 {
+        match (&self.envelope, &self.orca) {
+            (Some(_), Some(orca)) => orca.max_speed * dt + ENVELOPE_MARGIN,
+            _ => 0.0,
+        }
+    }
+
     /// Counts the contacts that started in the last step and returns where the body touches
     /// something now: Rapier's contacts within [`CONTACT_TOLERANCE`], and the wall collider
     /// `overlapped` that the disc is at or inside now, if any (by the clearance).
@@ -838,7 +837,6 @@ impl AgentRun {
     ) -> Vec<Vector2<f64>> {
         let mut now = HashSet::new();
         let mut points = Vec::new();
-        let touched_walls_before = self.touching.iter().any(|c| is_wall(physics, *c));
         for pair in physics.narrow_phase.contact_pairs_with(self.collider) {
             if !pair.has_any_active_contact() {
                 continue;
@@ -866,7 +864,7 @@ impl AgentRun {
         {
             // Rapier has not seen it (yet): the wall the clearance found, touched now. While
             // the body stays on walls, another collider of the same walls starts nothing new.
-            if touched_walls_before {
+            if self.touching.iter().any(|c| is_wall(physics, *c)) {
                 now.extend(self.touching.iter().filter(|c| is_wall(physics, **c)));
             } else {
                 now.insert(wall);

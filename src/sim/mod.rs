@@ -142,6 +142,11 @@ impl Simulation {
         })
     }
 
+    /// The walls by bucket, for clearance queries against `walls`.
+    pub fn wall_index(&self) -> &WallIndex {
+        &self.index
+    }
+
     /// The Rapier world, for scene queries (a lidar's ray casts).
     pub fn physics(&self) -> &PhysicsWorld {
         &self.physics
