@@ -2,6 +2,7 @@
 //! pre-smoothing and restriction, two visits of the next coarser level, prolongation and
 //! post-smoothing — with an exact solve on the coarsest level ([`Coarsest`]).
 
+use super::dense::Factor;
 use super::kernels::{dot, wide};
 use super::level::Level;
 use super::smoother::{Keep, keep_patterns};
@@ -17,9 +18,8 @@ const COARSEST: usize = 64;
 pub struct Coarsest {
     /// Padded index of each unknown.
     cells: Vec<usize>,
-    /// Lower-triangular factor, row-major `n × n`; a non-positive pivot (which an SPD matrix
-    /// never has, but rounding could) leaves its unknown at 0.
-    factor: Vec<f64>,
+    /// The Cholesky factor of the level's matrix (see [`Factor`]).
+    factor: Factor,
 }
 
 impl Coarsest {
@@ -49,18 +49,18 @@ impl Coarsest {
                 };
             }
         }
-        super::dense::cholesky(&mut a, n);
-        Self { cells, factor: a }
+        Self {
+            cells,
+            factor: Factor::new(a, n),
+        }
     }
 
     /// `x = A⁻¹ b` on the coarsest level.
     fn solve(&self, x: &mut [f32], b: &[f32], scratch: &mut Vec<f64>) {
-        let n = self.cells.len();
-        let l = &self.factor;
         scratch.clear();
         scratch.extend(self.cells.iter().map(|&k| f64::from(b[k])));
         let y = scratch;
-        super::dense::solve(l, n, y);
+        self.factor.solve(y);
         for (&k, &v) in self.cells.iter().zip(y.iter()) {
             x[k] = v as f32;
         }

@@ -593,7 +593,7 @@ impl Shared {
 /// The exact solve of the coarsest level (dense Cholesky of its active cells).
 struct Coarsest {
     cells: Vec<usize>,
-    factor: Vec<f64>,
+    factor: dense::Factor,
 }
 
 impl Coarsest {
@@ -625,17 +625,15 @@ impl Coarsest {
                 }
             }
         }
-        dense::cholesky(&mut a, n);
         Self {
             cells: cells.into_iter().map(|(p, _)| p).collect(),
-            factor: a,
+            factor: dense::Factor::new(a, n),
         }
     }
 
     fn solve(&self, x: &mut [f32], b: &[f32]) {
-        let n = self.cells.len();
         let mut y: Vec<f64> = self.cells.iter().map(|&p| f64::from(b[p])).collect();
-        dense::solve(&self.factor, n, &mut y);
+        self.factor.solve(&mut y);
         for (&p, v) in self.cells.iter().zip(y) {
             x[p] = v as f32;
         }
