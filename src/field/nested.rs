@@ -33,6 +33,8 @@
 //! accepts changes them by little (in a corridor of width `w`, by about `e^(−2π x / w)` at a
 //! distance `x`).
 
+use rayon::prelude::*;
+
 use super::banded;
 use super::grid::Grid;
 use super::multigrid;
@@ -140,6 +142,19 @@ pub fn deep_cells(grid: &Grid, unknown: &[bool], w: &[f64], depth: f64) -> Vec<b
     deep
 }
 
+/// A level's parts are solved in parallel when they hold at least this many cells together
+/// (below it, the threads would cost more than they save; the results are the same either way).
+pub const PARALLEL_CELLS: usize = 20_000;
+
+/// One part of a band, solved: its cells' values (in the part's order) at the scale `2^scale`.
+struct Solved {
+    values: Vec<f64>,
+    scale: i32,
+    /// CG iterations (0 for a direct solve).
+    iterations: usize,
+    relative_residual: f64,
+}
+
 /// The state of the nested levels over the whole grid. Every per-level pass touches only the
 /// cells of the band and the frontier (marks are level stamps, never cleared), so a level costs
 /// what its band costs however large the map.
@@ -159,7 +174,7 @@ struct Levels<'a> {
     part: Vec<u32>,
     /// Scratch marks for the per-part passes: `seen[k] == stamp`.
     seen: Vec<u32>,
-    /// A part's cell's index in the part (where `seen` marks the part).
+    /// A band cell's index in its part (set with `part` by `parts`).
     slot: Vec<u32>,
     stamp: u32,
     level: u32,
@@ -234,11 +249,29 @@ impl Levels<'_> {
         let lowest = top + LEVEL_RANGE.log2();
         let band = self.band_cells(lowest);
         let parts = self.parts(&band);
+        // The parts are disjoint and each reads only the accepted cells around it, so they are
+        // solved independently (in parallel when there is enough work) with the same results.
+        let this = &*self;
+        let solve = |(index, cells): (usize, &Vec<usize>)| this.solve_part(index as u32, cells);
+        let work: usize = parts.iter().map(Vec::len).sum();
+        let solved: Vec<Solved> = if parts.len() > 1 && work >= PARALLEL_CELLS {
+            parts.par_iter().enumerate().map(solve).collect()
+        } else {
+            parts.iter().enumerate().map(solve).collect()
+        };
         let mut accepted = Vec::new();
         let mut cut_limited = false;
-        for cells in &parts {
-            let scale = self.solve_part(cells);
-            let (resolved, limited) = self.resolved(cells, scale, lowest);
+        for (cells, solved) in parts.iter().zip(solved) {
+            self.stats.solves += 1;
+            self.stats.cells_solved += cells.len();
+            self.stats.iterations += solved.iterations;
+            self.stats.relative_residual =
+                self.stats.relative_residual.max(solved.relative_residual);
+            for (&k, &v) in cells.iter().zip(&solved.values) {
+                self.w.mantissa[k] = v;
+                self.w.exponent[k] = solved.scale;
+            }
+            let (resolved, limited) = self.resolved(cells, solved.scale, lowest);
             accepted.extend(resolved);
             cut_limited |= limited;
         }
@@ -349,6 +382,7 @@ impl Levels<'_> {
             let mut head = 0;
             while head < cells.len() {
                 let k = cells[head];
+                self.slot[k] = head as u32;
                 head += 1;
                 self.part[k] = index;
                 for m in self.neighbours(k) {
@@ -363,10 +397,11 @@ impl Levels<'_> {
         parts
     }
 
-    /// Solves one part of the band on its bounding box, with the accepted cells around it as
-    /// Dirichlet values and 0 at the cut, at the scale `2^e` of its largest accepted neighbour;
-    /// stores every cell of the part at that scale and returns `e`.
-    fn solve_part(&mut self, cells: &[usize]) -> i32 {
+    /// Solves part `index` of the band (its `cells`, in the order of their slots), with the
+    /// accepted cells around it as Dirichlet values and 0 at the cut, at the scale `2^e` of its
+    /// largest accepted neighbour: directly when it is narrow, else by multigrid on its bounding
+    /// box. Reads only `self`.
+    fn solve_part(&self, index: u32, cells: &[usize]) -> Solved {
         let scale = cells
             .iter()
             .flat_map(|&k| self.neighbours(k))
@@ -374,48 +409,39 @@ impl Levels<'_> {
             .map(|m| self.w.exponent[m] + exponent_of(self.w.mantissa[m]))
             .max()
             .unwrap_or(0);
-        self.stats.solves += 1;
-        self.stats.cells_solved += cells.len();
-        if !self.solve_narrow(cells, scale) {
-            self.solve_wide(cells, scale);
+        match self.solve_narrow(index, cells, scale) {
+            Some(values) => Solved {
+                values,
+                scale,
+                iterations: 0,
+                relative_residual: 0.0,
+            },
+            None => self.solve_wide(cells, scale),
         }
-        scale
     }
 
-    /// Solves a narrow part directly (see `banded.rs`) at the scale `2^scale`; `false` when it
+    /// Solves part `index` directly (see `banded.rs`) at the scale `2^scale`; `None` when it
     /// is too wide for that.
-    fn solve_narrow(&mut self, cells: &[usize], scale: i32) -> bool {
-        self.stamp += 1;
-        let mine = self.stamp;
-        for (index, &k) in cells.iter().enumerate() {
-            self.seen[k] = mine;
-            self.slot[k] = index as u32;
-        }
+    fn solve_narrow(&self, index: u32, cells: &[usize], scale: i32) -> Option<Vec<f64>> {
+        let mine = |m: usize| self.in_band(m) && self.part[m] == index;
         let mut neighbours = Vec::with_capacity(cells.len());
         let mut rhs = vec![0.0; cells.len()];
-        for (index, &k) in cells.iter().enumerate() {
+        for (slot, &k) in cells.iter().enumerate() {
             let mut inside = [u32::MAX; 4];
             for (n, m) in self.neighbours(k).enumerate() {
-                if self.seen[m] == mine {
+                if mine(m) {
                     inside[n] = self.slot[m];
                 } else if self.accepted(m) {
-                    rhs[index] += self.w.at_scale(m, scale);
+                    rhs[slot] += self.w.at_scale(m, scale);
                 }
             }
             neighbours.push(inside);
         }
-        let Some(u) = banded::solve(&neighbours, &rhs, MAX_BAND) else {
-            return false;
-        };
-        for (&k, u) in cells.iter().zip(u) {
-            self.w.mantissa[k] = u;
-            self.w.exponent[k] = scale;
-        }
-        true
+        banded::solve(&neighbours, &rhs, MAX_BAND)
     }
 
     /// Solves a wide part by multigrid on its bounding box, at the scale `2^scale`.
-    fn solve_wide(&mut self, cells: &[usize], scale: i32) {
+    fn solve_wide(&self, cells: &[usize], scale: i32) -> Solved {
         let g = self.grid;
         let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
         for &k in cells {
@@ -456,11 +482,11 @@ impl Levels<'_> {
             values[local(k)] = self.w.at_scale(k, scale).clamp(0.0, largest);
         }
         let stats = multigrid::solve(&sub, &unknown, &mut values, self.tolerance, MAX_ITERATIONS);
-        self.stats.iterations += stats.iterations;
-        self.stats.relative_residual = self.stats.relative_residual.max(stats.relative_residual);
-        for &k in cells {
-            self.w.mantissa[k] = values[local(k)];
-            self.w.exponent[k] = scale;
+        Solved {
+            values: cells.iter().map(|&k| values[local(k)]).collect(),
+            scale,
+            iterations: stats.iterations,
+            relative_residual: stats.relative_residual,
         }
     }
 
