@@ -24,7 +24,7 @@ pub struct Factor {
 
 impl Factor {
     /// Factors the row-major `n × n` matrix `a` (its lower triangle is read).
-    pub fn new(mut a: Vec<f64>, n: usize) -> Self {
+    pub fn new(a: Vec<f64>, n: usize) -> Self {
         assert_eq!(a.len(), n * n, "an n × n matrix");
         let first: Vec<usize> = (0..n)
             .map(|r| (0..r).find(|&c| a[r * n + c] != 0.0).unwrap_or(r))
@@ -35,6 +35,13 @@ impl Factor {
                 last[c] = last[c].max(r);
             }
         }
+        Self::within(a, n, first, last)
+    }
+
+    /// Factors `a` over the profile `first`, `last` (see the fields), which must hold every
+    /// nonzero of `a`'s lower triangle; the whole triangle (`first = 0`, `last = n − 1`) is
+    /// the plain dense factor.
+    fn within(mut a: Vec<f64>, n: usize, first: Vec<usize>, last: Vec<usize>) -> Self {
         for c in 0..n {
             let mut pivot = a[c * n + c];
             for p in first[c]..c {
@@ -50,7 +57,7 @@ impl Factor {
                 for p in first[r].max(first[c])..c {
                     v -= a[r * n + p] * a[c * n + p];
                 }
-                a[r * n + c] = if pivot > 0.0 { v / pivot } else { 0.0 };
+                a[r * n + c] = over_pivot(v, pivot);
             }
         }
         Self {
@@ -69,69 +76,31 @@ impl Factor {
             for p in self.first[r]..r {
                 v -= l[r * n + p] * y[p];
             }
-            y[r] = if l[r * n + r] > 0.0 {
-                v / l[r * n + r]
-            } else {
-                0.0
-            };
+            y[r] = over_pivot(v, l[r * n + r]);
         }
         for r in (0..n).rev() {
             let mut v = y[r];
             for p in r + 1..=self.last[r] {
                 v -= l[p * n + r] * y[p];
             }
-            y[r] = if l[r * n + r] > 0.0 {
-                v / l[r * n + r]
-            } else {
-                0.0
-            };
+            y[r] = over_pivot(v, l[r * n + r]);
         }
     }
+}
+
+/// `v / pivot`, or 0 for a non-positive pivot (its unknown is left at 0).
+fn over_pivot(v: f64, pivot: f64) -> f64 {
+    if pivot > 0.0 { v / pivot } else { 0.0 }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// The plain dense factor and solve: what the profile-limited ones must equal bit for bit.
-    fn dense(mut a: Vec<f64>, n: usize, y: &mut [f64]) {
-        for c in 0..n {
-            let mut pivot = a[c * n + c];
-            for p in 0..c {
-                pivot -= a[c * n + p] * a[c * n + p];
-            }
-            let pivot = if pivot > 0.0 { pivot.sqrt() } else { 0.0 };
-            a[c * n + c] = pivot;
-            for r in c + 1..n {
-                let mut v = a[r * n + c];
-                for p in 0..c {
-                    v -= a[r * n + p] * a[c * n + p];
-                }
-                a[r * n + c] = if pivot > 0.0 { v / pivot } else { 0.0 };
-            }
-        }
-        for r in 0..n {
-            let mut v = y[r];
-            for p in 0..r {
-                v -= a[r * n + p] * y[p];
-            }
-            y[r] = if a[r * n + r] > 0.0 {
-                v / a[r * n + r]
-            } else {
-                0.0
-            };
-        }
-        for r in (0..n).rev() {
-            let mut v = y[r];
-            for p in r + 1..n {
-                v -= a[p * n + r] * y[p];
-            }
-            y[r] = if a[r * n + r] > 0.0 {
-                v / a[r * n + r]
-            } else {
-                0.0
-            };
-        }
+    /// The plain dense factor and solve (the whole lower triangle as the profile): what the
+    /// profile-limited ones must equal bit for bit.
+    fn dense(a: Vec<f64>, n: usize, y: &mut [f64]) {
+        Factor::within(a, n, vec![0; n], vec![n - 1; n]).solve(y);
     }
 
     /// The 5-point matrix of a `nx × ny` grid with some cells removed (a wall), in row order.
