@@ -17,6 +17,7 @@
 //! - [`sweep`]: parameter sweeps in parallel, with a CSV and a plot (`nadf sweep`).
 //! - [`scen`]: Moving AI scenario batches on a map world (`nadf scen`).
 //! - [`reproduce`]: the paper, claim by claim, with a verdict per claim (`nadf reproduce`).
+//! - [`random`]: the one seeded generator, so a run is the same for a given seed.
 //! - [`cli`]: the `nadf` commands (the binary only parses and dispatches); [`output`]: writing
 //!   files whole or not at all, and checking outputs before a run.
 
@@ -28,6 +29,7 @@ pub mod expect;
 pub mod field;
 pub mod metrics;
 pub mod output;
+pub mod random;
 pub mod record;
 pub mod reproduce;
 pub mod run;

@@ -9,6 +9,7 @@
 use rapier2d::prelude::{ColliderHandle, PhysicsWorld, QueryFilter, Ray, Vector};
 
 use crate::field::Beam;
+use crate::random::SplitMix;
 use crate::world::SensorSettings;
 
 /// Rays per scan when the world file gives none.
@@ -19,7 +20,7 @@ pub const DEFAULT_RAYS: u32 = 360;
 pub struct Lidar {
     /// Its settings (a lidar's: `range` is set).
     pub settings: SensorSettings,
-    state: u64,
+    rng: SplitMix,
     /// Scans taken so far.
     pub scans: usize,
 }
@@ -30,7 +31,7 @@ impl Lidar {
         Self {
             settings,
             // Another stream than the walls sensor's for the same seed and agent.
-            state: seed ^ (index as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03),
+            rng: SplitMix::new(seed ^ (index as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03)),
             scans: 0,
         }
     }
@@ -65,7 +66,7 @@ impl Lidar {
                 .cast_ray(&ray, range as f32, true, filter)
                 .map(|(_, toi)| f64::from(toi));
             // Draw both every time, so that one ray's outcome does not shift the others' noise.
-            let (lost, noise) = (self.uniform() < dropout, self.normal());
+            let (lost, noise) = (self.rng.uniform() < dropout, self.rng.normal());
             if lost {
                 continue;
             }
@@ -80,22 +81,6 @@ impl Lidar {
             });
         }
         beams
-    }
-
-    /// A standard normal draw (Box–Muller).
-    fn normal(&mut self) -> f64 {
-        let u = 1.0 - self.uniform();
-        let v = self.uniform();
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-
-    /// A uniform draw in `[0, 1)`.
-    fn uniform(&mut self) -> f64 {
-        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
     }
 }
 

@@ -23,6 +23,7 @@ mod clearance;
 pub mod drive;
 pub mod faults;
 pub mod lidar;
+pub mod motion;
 pub mod pendulum;
 mod physics;
 mod sensor;

@@ -10,6 +10,7 @@
 //! With `position_noise` the agent's estimate of its own position is off too: each reading
 //! draws an error uniform in `[-σ, σ]` per axis (after the walls' draws), held until the next.
 
+use crate::random::SplitMix;
 use crate::world::SensorSettings;
 
 /// One agent's wall sensor.
@@ -17,7 +18,7 @@ use crate::world::SensorSettings;
 pub struct Sensor {
     /// The sensor's settings.
     pub settings: SensorSettings,
-    state: u64,
+    rng: SplitMix,
     /// Readings taken so far.
     pub readings: usize,
 }
@@ -28,10 +29,10 @@ impl Sensor {
         // Distinct, well-mixed streams per agent for the same world seed.
         let mut sensor = Self {
             settings,
-            state: seed ^ (index as u64 + 1).wrapping_mul(0xA076_1D64_78BD_642F),
+            rng: SplitMix::new(seed ^ (index as u64 + 1).wrapping_mul(0xA076_1D64_78BD_642F)),
             readings: 0,
         };
-        sensor.next_u64();
+        sensor.rng.next_u64();
         sensor
     }
 
@@ -64,16 +65,7 @@ impl Sensor {
 
     /// A uniform draw in `[0, 1)`.
     fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// SplitMix64 (Steele, Lea and Flood 2014).
-    fn next_u64(&mut self) -> u64 {
-        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.rng.uniform()
     }
 }
 

@@ -3,6 +3,8 @@
 //! `maze512-1-*` maps), carved by a randomized depth-first search from a seed, so a maze is
 //! the same every time.
 
+use crate::random::SplitMix;
+
 /// A `(2n + 1) × (2n + 1)` perfect maze of `n × n` rooms, padded with walls to `size × size`
 /// when `size` is larger, as the text of a Moving AI `.map` (`type octile`). The rooms are the
 /// cells at odd coordinates; the entrance room is `(1, 1)` in the text (the top left), so
@@ -11,7 +13,7 @@ pub fn perfect_maze(n: usize, size: usize, seed: u64) -> String {
     let side = 2 * n + 1;
     let size = size.max(side);
     let mut open = vec![false; side * side];
-    let mut rng = SplitMix(seed);
+    let mut rng = SplitMix::new(seed);
     let room = |i: usize, j: usize| (2 * j + 1) * side + 2 * i + 1;
     let mut stack = vec![(0usize, 0usize)];
     let mut visited = vec![false; n * n];
@@ -35,7 +37,7 @@ pub fn perfect_maze(n: usize, size: usize, seed: u64) -> String {
             stack.pop();
             continue;
         }
-        let (a, b) = next[(rng.next() % next.len() as u64) as usize];
+        let (a, b) = next[(rng.next_u64() % next.len() as u64) as usize];
         visited[b * n + a] = true;
         open[room(a, b)] = true;
         // The wall between the two rooms.
@@ -51,19 +53,6 @@ pub fn perfect_maze(n: usize, size: usize, seed: u64) -> String {
         text.push('\n');
     }
     text
-}
-
-/// SplitMix64 (Steele, Lea and Flood 2014).
-struct SplitMix(u64);
-
-impl SplitMix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
 }
 
 #[cfg(test)]
