@@ -87,6 +87,7 @@ impl Lidar {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::field::{Grid, KnownMap};
     use crate::world::SensorKind;
     use rapier2d::prelude::{ColliderBuilder, RigidBodyBuilder};
 
@@ -146,5 +147,48 @@ mod tests {
             .sum();
         // 2000 rays, 30 % lost.
         assert!((1300..1500).contains(&kept), "{kept}");
+    }
+    /// A moving body (a kinematic one, as a scripted obstacle is) is in the scans, and the
+    /// map built from them forgets the cells it has left: the beams that now pass through
+    /// them lower their log-odds until they read free again.
+    #[test]
+    fn the_map_sees_a_moving_body_and_forgets_where_it_was() {
+        let mut physics = PhysicsWorld::default();
+        let (_, own) = physics.insert(
+            RigidBodyBuilder::dynamic().translation(Vector::new(2.0, 5.0)),
+            ColliderBuilder::ball(0.2),
+        );
+        let (mover, _) = physics.insert(
+            RigidBodyBuilder::kinematic_position_based().translation(Vector::new(4.0, 5.0)),
+            ColliderBuilder::ball(0.3),
+        );
+        physics.step();
+        let mut scanner = lidar(0.0, 0.0);
+        scanner.settings.rays = Some(360);
+        let mut map = KnownMap::new(Grid::covering([10.0, 10.0], 0.1));
+        let occupied_near = |map: &KnownMap, c: [f64; 2]| {
+            let grid = *map.grid();
+            (0..grid.ny)
+                .flat_map(|j| (0..grid.nx).map(move |i| (i, j)))
+                .filter(|&(i, j)| map.occupied()[grid.index(i, j)])
+                .filter(|&(i, j)| {
+                    let p = grid.center(i, j);
+                    (p[0] - c[0]).hypot(p[1] - c[1]) < 0.5
+                })
+                .count()
+        };
+        for _ in 0..20 {
+            map.update(&scanner.scan(&physics, [2.0, 5.0], 0.0, own));
+        }
+        assert!(occupied_near(&map, [4.0, 5.0]) > 0);
+        physics.bodies[mover].set_next_kinematic_translation(Vector::new(4.0, 8.5));
+        physics.step();
+        let mut scans = 0;
+        while occupied_near(&map, [4.0, 5.0]) > 0 {
+            scans += 1;
+            assert!(scans <= 10, "the map still holds the body where it was");
+            map.update(&scanner.scan(&physics, [2.0, 5.0], 0.0, own));
+        }
+        assert!(occupied_near(&map, [4.0, 8.5]) > 0);
     }
 }
