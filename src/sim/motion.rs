@@ -74,11 +74,7 @@ impl Motion {
     /// The script from its start (a path's first waypoint, else the origin: see
     /// [`Motion::starting_at`]), with the random stream of `seed` for a wander.
     pub fn new(script: Script, seed: u64) -> Self {
-        let start = match &script {
-            Script::Path { points, .. } => points[0],
-            _ => Vector2::zeros(),
-        };
-        Self::starting_at(script, start, seed)
+        Self::starting_at(script, Vector2::zeros(), seed)
     }
 
     /// The script from `start`, m (a path starts at its first waypoint whatever `start` is).
