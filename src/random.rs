@@ -47,8 +47,8 @@ impl SplitMix {
 mod tests {
     use super::*;
 
-    /// The published first outputs of SplitMix64 seeded with 1234567 (from the reference C
-    /// implementation, `splitmix64.c`).
+    /// The first outputs of SplitMix64 seeded with 1234567, as an independent transcription
+    /// of the reference C code (`splitmix64.c`, Vigna) computes them.
     #[test]
     fn the_stream_is_splitmix64() {
         let mut r = SplitMix::new(1234567);

@@ -148,6 +148,7 @@ mod tests {
         // 2000 rays, 30 % lost.
         assert!((1300..1500).contains(&kept), "{kept}");
     }
+
     /// A moving body (a kinematic one, as a scripted obstacle is) is in the scans, and the
     /// map built from them forgets the cells it has left: the beams that now pass through
     /// them lower their log-odds until they read free again.

@@ -62,6 +62,9 @@ pub enum Script {
 #[derive(Debug, Clone)]
 pub struct Motion {
     script: Script,
+    /// A path's waypoints as followed (a loop's closed by its first waypoint again) and their
+    /// length, m: laid out once, not at every step.
+    route: (Vec<Vector2<f64>>, f64),
     start: Vector2<f64>,
     position: Vector2<f64>,
     time: f64,
@@ -83,10 +86,22 @@ impl Motion {
             Script::Path { points, .. } => points[0],
             _ => start,
         };
+        let route = match &script {
+            Script::Path { points, mode, .. } => {
+                let mut route = points.clone();
+                if *mode == PathMode::Loop {
+                    route.push(points[0]);
+                }
+                let length = route.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+                (route, length)
+            }
+            _ => (Vec::new(), 0.0),
+        };
         let mut rng = SplitMix::new(seed ^ 0x5851_F42D_4C95_7F2D);
         let heading = rng.uniform() * std::f64::consts::TAU;
         Self {
             script,
+            route,
             start,
             position: start,
             time: 0.0,
@@ -112,11 +127,7 @@ impl Motion {
         // The time as a multiple of steps, not a running sum: no drift over a long run.
         self.time = self.steps as f64 * dt;
         self.position = match &self.script {
-            Script::Path {
-                points,
-                speed,
-                mode,
-            } => along(points, *mode, speed * self.time),
+            Script::Path { speed, mode, .. } => along(&self.route, *mode, speed * self.time),
             Script::Velocity(v) => self.start + v * self.time,
             Script::Wander {
                 speed,
@@ -159,14 +170,10 @@ impl Motion {
     }
 }
 
-/// The point at arc length `s` (m) along the waypoints `points` followed in `mode`.
-fn along(points: &[Vector2<f64>], mode: PathMode, s: f64) -> Vector2<f64> {
-    let mut legs: Vec<(Vector2<f64>, Vector2<f64>)> =
-        points.windows(2).map(|w| (w[0], w[1])).collect();
-    if mode == PathMode::Loop {
-        legs.push((points[points.len() - 1], points[0]));
-    }
-    let length: f64 = legs.iter().map(|(a, b)| (b - a).norm()).sum();
+/// The point at arc length `s` (m) along `route` (its waypoints as followed and their length)
+/// in `mode`.
+fn along((points, length): &(Vec<Vector2<f64>>, f64), mode: PathMode, s: f64) -> Vector2<f64> {
+    let length = *length;
     if length <= 0.0 {
         return points[0];
     }
@@ -179,18 +186,15 @@ fn along(points: &[Vector2<f64>], mode: PathMode, s: f64) -> Vector2<f64> {
         PathMode::Once => s.min(length),
     };
     let mut left = s;
-    for (a, b) in &legs {
+    for leg in points.windows(2) {
+        let (a, b) = (leg[0], leg[1]);
         let l = (b - a).norm();
         if left <= l {
-            return if l > 0.0 {
-                a + (b - a) * (left / l)
-            } else {
-                *a
-            };
+            return if l > 0.0 { a + (b - a) * (left / l) } else { a };
         }
         left -= l;
     }
-    legs.last().map_or(points[0], |(_, b)| *b)
+    points[points.len() - 1]
 }
 
 #[cfg(test)]
