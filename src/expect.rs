@@ -316,6 +316,8 @@ mod tests {
             settling_time: Some(5.0),
             final_error: 0.01,
             contacts: 0,
+            obstacle_contacts: 0,
+            min_obstacle_distance: None,
             min_clearance: Some(0.3),
             max_deviation: 0.2,
             path_length: 10.0,

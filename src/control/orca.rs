@@ -30,6 +30,10 @@ pub struct Neighbour {
     pub velocity: Vector2<f64>,
     /// Radius, m.
     pub radius: f64,
+    /// Whether it takes its half of the avoiding, as an agent running ORCA does; a scripted
+    /// obstacle does not, and leaves all of it to the agent (ORCA's avoidance responsibility:
+    /// 1 or 0).
+    pub reciprocal: bool,
 }
 
 /// ORCA's settings for one agent.
@@ -94,7 +98,7 @@ impl Orca {
             position: to_orca(n.position),
             velocity: to_orca(n.velocity),
             radius: n.radius as f32,
-            avoidance_responsibility: 1.0,
+            avoidance_responsibility: if n.reciprocal { 1.0 } else { 0.0 },
         };
         let near: Vec<Cow<'_, Agent>> = neighbours
             .iter()
@@ -173,11 +177,13 @@ mod tests {
             position: Vector2::new(0.0, 0.0),
             velocity: Vector2::new(2.0, 0.0),
             radius: 0.3,
+            reciprocal: true,
         };
         let b = Neighbour {
             position: Vector2::new(2.0, 0.0),
             velocity: Vector2::new(-2.0, 0.0),
             radius: 0.3,
+            reciprocal: true,
         };
         let va = orca().velocity(&a, Vector2::new(2.0, 0.0), &[b], 0.01);
         let vb = orca().velocity(&b, Vector2::new(-2.0, 0.0), &[a], 0.01);
@@ -188,6 +194,17 @@ mod tests {
         // Nobody in the way: the preferred velocity itself.
         let alone = orca().velocity(&a, Vector2::new(2.0, 0.0), &[], 0.01);
         assert!((alone - Vector2::new(2.0, 0.0)).norm() < 1e-6);
+        // The same body as a scripted obstacle, which holds its course: the agent does all
+        // the avoiding, so it turns further aside than when the other takes its half.
+        let obstacle = Neighbour {
+            reciprocal: false,
+            ..b
+        };
+        let alone_avoids = orca().velocity(&a, Vector2::new(2.0, 0.0), &[obstacle], 0.01);
+        assert!(
+            alone_avoids.y.abs() > va.y.abs() + 0.05,
+            "{alone_avoids} vs {va}"
+        );
     }
 
     /// The tracking law's split gives the same force as the law, and pulls the velocity

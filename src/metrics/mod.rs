@@ -63,6 +63,11 @@ crate::measured! {
         /// negative by the depth when it overlapped one (always counted as a contact); `None`
         /// in a world without walls.
         pub min_clearance: Option<f64> [unit("m"), column("clear_m"), missing("no walls")],
+        /// Contact starts with moving obstacles (counted in `contacts` too).
+        pub obstacle_contacts: usize,
+        /// Smallest signed distance from the agent's disc to any moving obstacle after a step,
+        /// m (negative by the depth of an overlap); `None` in a world without obstacles.
+        pub min_obstacle_distance: Option<f64> [unit("m"), missing("no obstacles")],
         /// `δ_m`: largest distance from the dynamic to the kinematic path, m.
         pub max_deviation: f64 [unit("m"), column("dev_m")],
         /// Length of the dynamic path, m.
@@ -150,6 +155,8 @@ pub struct Metrics {
     settled_at: Option<f64>,
     final_distance: f64,
     contacts: usize,
+    obstacle_contacts: usize,
+    min_obstacle_distance: Option<f64>,
     min_clearance: f64,
     envelope_time: f64,
     path: Vec<[f64; 2]>,
@@ -196,6 +203,8 @@ impl Metrics {
             settled_at: None,
             final_distance: d0,
             contacts: 0,
+            obstacle_contacts: 0,
+            min_obstacle_distance: None,
             min_clearance: f64::INFINITY,
             envelope_time: 0.0,
             path: vec![start.into()],
@@ -283,6 +292,17 @@ impl Metrics {
         self.contacts += n;
     }
 
+    /// Counts `n` new contact starts with moving obstacles (already counted as contacts).
+    pub fn record_obstacle_contacts(&mut self, n: usize) {
+        self.obstacle_contacts += n;
+    }
+
+    /// Records the signed distance from the agent's disc to the nearest moving obstacle after
+    /// a step, m.
+    pub fn record_obstacle_distance(&mut self, d: f64) {
+        self.min_obstacle_distance = Some(self.min_obstacle_distance.map_or(d, |m| m.min(d)));
+    }
+
     /// Records the gap between the agent's disc and the nearest other agent's after a step, m.
     pub fn record_separation(&mut self, gap: f64) {
         self.min_separation = Some(self.min_separation.map_or(gap, |s| s.min(gap)));
@@ -327,6 +347,8 @@ impl Metrics {
             settling_time: if reached { self.settled_at } else { None },
             final_error: self.final_distance,
             contacts: self.contacts,
+            obstacle_contacts: self.obstacle_contacts,
+            min_obstacle_distance: self.min_obstacle_distance,
             min_clearance: self.min_clearance.is_finite().then_some(self.min_clearance),
             envelope_time: self.envelope_time,
             max_deviation,

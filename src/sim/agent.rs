@@ -121,10 +121,15 @@ pub struct LidarRun {
     pub lidar: Lidar,
     /// The map built from its scans.
     pub map: KnownMap,
-    /// When the known map closed every route to the target, s.
+    /// When the known map closed every route to the target, s (in a world with moving
+    /// obstacles: when it last did, if no route has opened since).
     pub intractable_at: Option<f64>,
     /// Fields solved on the map so far (the first one counts).
     pub fields: usize,
+    /// Whether it scans on, standing still, while its map closes every route: in a world with
+    /// moving obstacles what closes a route (a shut door, a cart) may move away again; in a
+    /// still world it is final and the agent stops for good.
+    pub keeps_looking: bool,
 }
 
 /// What one step produces for the recording, collected from `plan` to `observe`.
@@ -229,6 +234,7 @@ impl AgentRun {
                 map: KnownMap::new(*h.grid()),
                 intractable_at: None,
                 fields: 1,
+                keeps_looking: !world.obstacles.is_empty(),
             });
         // A lidar agent plans on what it sees; its kinematic path is the one with full
         // knowledge of the walls (empty if the true walls enclose its target).
@@ -334,6 +340,7 @@ impl AgentRun {
             position: p,
             velocity: v,
             radius: self.agent.radius,
+            reciprocal: true,
         }
     }
 
@@ -394,7 +401,7 @@ impl AgentRun {
         }
         let mut map_changed = false;
         if let Some(run) = &mut self.lidar
-            && run.intractable_at.is_none()
+            && (run.intractable_at.is_none() || run.keeps_looking)
             && run.lidar.due(time)
         {
             let to_target = Vector2::from(self.agent.target) - x;
@@ -627,14 +634,16 @@ impl AgentRun {
     }
 
     /// Step 4: after Rapier's step that ended at `time` (s), reads the state back, counts
-    /// contact starts, watches for faults against `walls` and the box `bounds`, and updates
-    /// the metrics.
+    /// contact starts, watches for faults against `walls` and the box `bounds`, measures the
+    /// distance to the moving `obstacles` (their shapes now, with their colliders), and
+    /// updates the metrics.
     pub(super) fn observe(
         &mut self,
         physics: &PhysicsWorld,
         time: f64,
         (walls, index, colliders): (&[WallShape], &WallIndex, &[ColliderHandle]),
         bounds: ([f64; 2], [f64; 2]),
+        obstacles: &[(WallShape, ColliderHandle)],
     ) -> AgentState {
         let (position, velocity) = self.read_state(physics);
         let p: [f64; 2] = position.into();
@@ -656,7 +665,18 @@ impl AgentRun {
         // A disc at or inside a wall touches it, whatever Rapier's narrow phase has seen yet
         // (it runs at the start of a step, so it sees the end of this one only in the next).
         let overlapped = nearest.filter(|_| signed <= 0.0).map(|k| colliders[k]);
-        let contact_points = self.contacts(physics, (centre, radius), overlapped);
+        let nearest_obstacle = (obstacles.iter())
+            .map(|(shape, collider)| {
+                let d = shape.signed_distance_to_point(centre.x, centre.y) - radius;
+                (d, *collider)
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((d, _)) = nearest_obstacle {
+            self.metrics.record_obstacle_distance(d);
+        }
+        // Likewise an obstacle the disc is at or inside now.
+        let on_obstacle = nearest_obstacle.filter(|(d, _)| *d <= 0.0).map(|(_, c)| c);
+        let contact_points = self.contacts(physics, (centre, radius), overlapped, on_obstacle);
         if let (Some(metrics), Some(wheels)) = (&mut self.drive, self.log.wheels) {
             metrics.record(&wheels, centre);
         }
@@ -720,6 +740,12 @@ impl AgentRun {
                 self.metrics.record_resolve();
                 if let Some(run) = &mut self.lidar {
                     run.fields += 1;
+                    if run.intractable_at.take().is_some() {
+                        self.log.notes.push(format!(
+                            "a route to the target is open again at t = {:.2} s; going on",
+                            plan.time
+                        ));
+                    }
                 }
                 if plan.sensed_now {
                     self.log.sensed_walls = Some(boundary(field));
@@ -732,13 +758,20 @@ impl AgentRun {
                         FieldError::Unreachable { .. } | FieldError::TargetBlocked { .. }
                     ) =>
             {
-                if let Some(run) = &mut self.lidar {
+                if let Some(run) = &mut self.lidar
+                    && run.intractable_at.is_none()
+                {
                     run.intractable_at = Some(plan.time);
+                    let then = if run.keeps_looking {
+                        "waiting for the moving obstacles to open one"
+                    } else {
+                        "stopping"
+                    };
+                    self.log.events.push(format!(
+                        "intractable at t = {:.2} s: the walls seen so far close every route to the target ({e}); {then}",
+                        plan.time
+                    ));
                 }
-                self.log.events.push(format!(
-                    "intractable at t = {:.2} s: the walls seen so far close every route to the target ({e}); stopping",
-                    plan.time
-                ));
             }
             (GuidanceField::Harmonic(_), Some(Err(e))) => {
                 if !self.rebuild_failed {
@@ -777,6 +810,7 @@ impl AgentRun {
                     position: x,
                     velocity: v,
                     radius,
+                    reciprocal: true,
                 };
                 let preferred = orca.preferred_velocity(gradient, *offset);
                 orca.velocity(&me, preferred, neighbours, dt)
@@ -827,13 +861,15 @@ impl AgentRun {
     }
 
     /// Counts the contacts that started in the last step and returns where the body touches
-    /// something now: Rapier's contacts within [`CONTACT_TOLERANCE`], and the wall collider
-    /// `overlapped` that the disc is at or inside now, if any (by the clearance).
+    /// something now: Rapier's contacts within [`CONTACT_TOLERANCE`], the wall collider
+    /// `overlapped` that the disc is at or inside now, if any (by the clearance), and the
+    /// moving obstacle it is at or inside now, `on_obstacle`.
     fn contacts(
         &mut self,
         physics: &PhysicsWorld,
         (position, radius): (Vector2<f64>, f64),
         overlapped: Option<ColliderHandle>,
+        on_obstacle: Option<ColliderHandle>,
     ) -> Vec<Vector2<f64>> {
         let mut now = HashSet::new();
         let mut points = Vec::new();
@@ -875,13 +911,28 @@ impl AgentRun {
                 points.push(from_rapier(q.point));
             }
         }
-        let started = now.difference(&self.touching).count();
+        if let Some(obstacle) = on_obstacle
+            && now.insert(obstacle)
+            && let Some(shape) = physics.colliders.get(obstacle)
+        {
+            let p = physics::to_rapier(position);
+            let q = shape.shape().project_point(shape.position(), p, false);
+            points.push(from_rapier(q.point));
+        }
+        let started: Vec<ColliderHandle> = now.difference(&self.touching).copied().collect();
+        let with_obstacles = started.iter().filter(|c| is_obstacle(physics, **c)).count();
         self.touching = now;
-        self.metrics.record_contacts(started);
-        if started > 0 {
+        self.metrics.record_contacts(started.len());
+        self.metrics.record_obstacle_contacts(with_obstacles);
+        if !started.is_empty() {
             // A contact is a failure of the run: an event on the timeline, not just a mark.
+            let what = if with_obstacles > 0 {
+                ", a moving obstacle among them"
+            } else {
+                ""
+            };
             self.log.events.push(format!(
-                "contact at [{:.3}, {:.3}] m ({} collider(s) touched now)",
+                "contact at [{:.3}, {:.3}] m ({} collider(s) touched now{what})",
                 position.x,
                 position.y,
                 self.touching.len()
@@ -913,6 +964,14 @@ fn boundary(field: &HarmonicField) -> Vec<[f64; 2]> {
         }
     }
     points
+}
+
+/// Whether `collider` is a moving obstacle's (on a kinematic body).
+fn is_obstacle(physics: &PhysicsWorld, collider: ColliderHandle) -> bool {
+    (physics.colliders.get(collider))
+        .and_then(|c| c.parent())
+        .and_then(|b| physics.bodies.get(b))
+        .is_some_and(|b| b.is_kinematic())
 }
 
 /// Whether `collider` is one of the walls (on the fixed body they all hang from).

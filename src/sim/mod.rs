@@ -12,6 +12,9 @@
 //! then, warm-started from the last solve; an attractive-repulsive one sees them at every step.
 //! The agents whose fields are due are re-solved in parallel (rayon), after every agent's state
 //! and sensor reading have been taken in order, so a run does not depend on the threads.
+//! Moving obstacles ([`obstacles`]) are kinematic bodies that Rapier moves along their scripts;
+//! an agent with a lidar sees them in its scans, any other agent as it sees the other agents
+//! (discs that hold them, grown by how far they move before the next replan).
 //! A noisy sensor rebuilds the field from each reading. A rebuild that fails (the others or the
 //! sensed walls cut the agent off) keeps the last field and logs a note once.
 
@@ -24,6 +27,7 @@ pub mod drive;
 pub mod faults;
 pub mod lidar;
 pub mod motion;
+pub mod obstacles;
 pub mod pendulum;
 mod physics;
 mod sensor;
@@ -79,6 +83,8 @@ pub struct Simulation {
     pub shaped: Vec<shaped::ShapedRun>,
     /// The arms, planned in joint space.
     pub arms: Vec<arm_run::ArmRun>,
+    /// The moving obstacles.
+    pub obstacles: Vec<obstacles::ObstacleRun>,
     physics: PhysicsWorld,
     time: f64,
     steps: usize,
@@ -95,18 +101,36 @@ impl Simulation {
         let mut physics = physics::empty_world(world.dt, world.external_acceleration);
         let walls = all_wall_shapes(world);
         let wall_colliders = physics::insert_walls(&mut physics, &walls);
-        let starts: Vec<Disc> = world
+        let obstacles: Vec<_> = (0..world.obstacles.len())
+            .map(|index| obstacles::ObstacleRun::new(world, index, &mut physics))
+            .collect();
+        let starts: Vec<Neighbour> = world
             .agents
             .iter()
-            .map(|a| Disc {
-                center: a.start,
+            .map(|a| Neighbour {
+                position: a.start.into(),
+                velocity: a.initial_velocity.into(),
                 radius: a.radius,
+                reciprocal: true,
             })
             .collect();
+        let seen = sighted(&obstacles, world.field.obstacle_horizon);
+        let disc = |n: Neighbour| Disc {
+            center: n.position.into(),
+            radius: n.radius,
+        };
         // Every agent's first field, in parallel (each reads only its own agent).
         let fields: Vec<Result<_, FieldError>> = (0..world.agents.len())
             .into_par_iter()
-            .map(|index| first_field(world, index, &others_than(&starts, index)))
+            .map(|index| {
+                let lidar = has_lidar(&world.agents[index]);
+                let others = seen_by(&starts, &seen, index, lidar);
+                first_field(
+                    world,
+                    index,
+                    &others.into_iter().map(disc).collect::<Vec<_>>(),
+                )
+            })
             .collect();
         let mut agents = Vec::with_capacity(world.agents.len());
         for (index, field) in fields.into_iter().enumerate() {
@@ -137,6 +161,7 @@ impl Simulation {
             pendulums,
             shaped,
             arms,
+            obstacles,
             physics,
             time: 0.0,
             steps: 0,
@@ -167,9 +192,18 @@ impl Simulation {
     /// re-solve the due fields in parallel, apply the controls, step Rapier, observe.
     pub fn step(&mut self) -> Vec<AgentState> {
         let bodies: Vec<Neighbour> = self.agents.iter().map(|a| a.body(&self.physics)).collect();
+        let seen = sighted(&self.obstacles, 0.0);
+        let ahead = sighted(&self.obstacles, self.world.field.obstacle_horizon);
         let scene = (&self.world, self.walls.as_slice());
         let plans: Vec<_> = (self.agents.iter_mut().enumerate())
-            .map(|(i, a)| a.plan(&self.physics, self.time, scene, others_than(&bodies, i)))
+            .map(|(i, a)| {
+                // ORCA extrapolates the velocities itself; a field is solved on where the
+                // obstacles are going.
+                let orca = a.agent.controller.kind == ControllerKind::Orca;
+                let obstacles = if orca { &seen } else { &ahead };
+                let others = seen_by(&bodies, obstacles, i, a.lidar.is_some());
+                a.plan(&self.physics, self.time, scene, others)
+            })
             .collect();
         // Each re-solve reads only its own agent, so the results do not depend on the threads.
         let solved: Vec<_> = (self.agents.par_iter().zip(&plans))
@@ -194,6 +228,9 @@ impl Simulation {
         for a in &mut self.arms {
             a.apply(&mut self.physics, self.world.dt);
         }
+        for o in &mut self.obstacles {
+            o.advance(&mut self.physics, self.world.dt);
+        }
         self.physics.step();
         self.steps += 1;
         self.time = self.steps as f64 * self.world.dt;
@@ -212,8 +249,11 @@ impl Simulation {
             self.wall_colliders.as_slice(),
         );
         let bounds = self.world.bounds();
+        let obstacles: Vec<_> = (self.obstacles.iter())
+            .map(|o| (o.shape(), o.collider()))
+            .collect();
         let mut states: Vec<AgentState> = (self.agents.iter_mut())
-            .map(|a| a.observe(&self.physics, self.time, walls, bounds))
+            .map(|a| a.observe(&self.physics, self.time, walls, bounds, &obstacles))
             .collect();
         self.watch_neighbours(&mut states);
         states
@@ -320,6 +360,31 @@ fn first_field(
         harmonic.check_start(agent)?;
     }
     Ok((field, walls))
+}
+
+/// What the agents without a lidar see of the moving obstacles: the discs that hold each one
+/// where it is now and where it will be over the next `horizon` seconds at its velocity.
+fn sighted(obstacles: &[obstacles::ObstacleRun], horizon: f64) -> Vec<Neighbour> {
+    (obstacles.iter())
+        .flat_map(|o| o.neighbours_ahead(horizon))
+        .collect()
+}
+
+/// Whether an agent scans with a lidar (it sees the moving obstacles in its map, not as discs).
+fn has_lidar(agent: &crate::world::Agent) -> bool {
+    agent
+        .sensor
+        .is_some_and(|s| s.kind == crate::world::SensorKind::Lidar)
+}
+
+/// What agent `index` sees as neighbours: the other agents' `bodies`, and the discs `seen` of
+/// the moving obstacles unless it has a `lidar`.
+fn seen_by(bodies: &[Neighbour], seen: &[Neighbour], index: usize, lidar: bool) -> Vec<Neighbour> {
+    let mut others = others_than(bodies, index);
+    if !lidar {
+        others.extend_from_slice(seen);
+    }
+    others
 }
 
 /// Every item of `items` but the one at `index`.

@@ -111,9 +111,10 @@ pub fn step_of(physics: &PhysicsWorld, dt: f64) -> Step {
     }
 }
 
-/// Whether `sweep` keeps the envelope's margin from every wall (Rapier's fixed colliders):
-/// its disc cast along each of its segments. A disc already that near and moving away is
-/// clear.
+/// Whether `sweep` keeps the envelope's margin from every wall (Rapier's fixed colliders) and
+/// every moving obstacle where it is now (the kinematic ones): its disc cast along each of its
+/// segments. A disc already that near and moving away is clear. (An obstacle moves on during
+/// the step: the envelope keeps a body from driving into one, not one from running into it.)
 pub fn clear_of_walls(physics: &PhysicsWorld, sweep: &Sweep) -> bool {
     let ball = Ball::new(sweep.radius as f32);
     sweep.segments().iter().all(|&(from, to)| {
@@ -132,7 +133,7 @@ pub fn clear_of_walls(physics: &PhysicsWorld, sweep: &Sweep) -> bool {
             to_rapier((to - from) / length),
             &ball,
             options,
-            QueryFilter::only_fixed(),
+            QueryFilter::exclude_dynamic(),
         );
         hit.is_none()
     })

@@ -8,6 +8,7 @@ mod body;
 mod error;
 mod load;
 pub mod map;
+mod obstacle;
 mod schema;
 mod shapes;
 pub(crate) mod suggest;
@@ -17,6 +18,7 @@ pub use arm::{Chain, Link};
 pub use body::BodyShape;
 pub use error::{WorldError, WorldErrors};
 pub use load::{Override, WorldFile, load, load_str};
+pub use obstacle::{Obstacle, ObstacleMode, ObstacleShape};
 pub use schema::{
     Agent, AgentShape, ArmSettings, Attraction, BiasSettings, ClampSettings, ControllerKind,
     ControllerSettings, DEFAULT_K, DriveKind, DriveSettings, Expect, ExpectValue, FieldKind,

@@ -57,6 +57,9 @@ pub struct World {
     /// Static obstacles.
     #[serde(default)]
     pub walls: Vec<Wall>,
+    /// Moving obstacles: shapes that follow scripts of their own and plan nothing.
+    #[serde(default)]
+    pub obstacles: Vec<super::obstacle::Obstacle>,
     /// The controlled bodies (a world needs at least one agent or pendulum).
     #[serde(default)]
     pub agents: Vec<Agent>,
@@ -217,6 +220,12 @@ pub struct FieldSettings {
     /// `replan_window` takes its edge from it. At most `replan_window`: no coarse window.
     #[serde(default = "default_replan_reach")]
     pub replan_reach: f64,
+    /// How far ahead the agents without a lidar extrapolate a moving obstacle's motion, s: a
+    /// harmonic field is solved with each obstacle where it is and where its velocity takes it
+    /// over this time, so the way it leaves is behind a crossing obstacle, not ahead of it
+    /// (0: where it is only). ORCA extrapolates by itself and sees the obstacles where they are.
+    #[serde(default = "default_obstacle_horizon")]
+    pub obstacle_horizon: f64,
     /// For an agent with a shape: heading cells over a full turn of the (x, y, θ) grid (an
     /// even number, at least 8).
     #[serde(default = "default_headings")]
@@ -284,6 +293,7 @@ impl Default for FieldSettings {
             replan_window: default_replan_window(),
             replan_reach: default_replan_reach(),
             headings: default_headings(),
+            obstacle_horizon: default_obstacle_horizon(),
             attraction: Attraction::default(),
             eta: None,
             rho0: None,
@@ -931,6 +941,9 @@ fn default_replan_window() -> f64 {
 fn default_replan_reach() -> f64 {
     24.0
 }
+fn default_obstacle_horizon() -> f64 {
+    1.0
+}
 fn default_headings() -> i64 {
     64
 }
@@ -1013,7 +1026,7 @@ fn wall_points<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Erro
         .collect()
 }
 
-fn fixed_length<E: serde::de::Error, const N: usize>(
+pub(super) fn fixed_length<E: serde::de::Error, const N: usize>(
     items: Vec<f64>,
     name: Option<&str>,
 ) -> Result<[f64; N], E> {

@@ -22,6 +22,11 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
         non_negative(&mut bad, "distance_at", at);
     }
     positive(&mut bad, "field.cell", world.field.cell);
+    non_negative(
+        &mut bad,
+        "field.obstacle_horizon",
+        world.field.obstacle_horizon,
+    );
     finite_point(
         &mut bad,
         "external_acceleration",
@@ -81,6 +86,9 @@ pub fn validate(world: &World) -> Vec<(String, String)> {
 
     for (i, wall) in world.walls.iter().enumerate() {
         check_wall(&mut bad, &format!("walls.{i}"), wall);
+    }
+    for i in 0..world.obstacles.len() {
+        super::obstacle::check(&mut bad, world, i);
     }
 
     if let Some(expect) = &world.expect {
@@ -803,7 +811,7 @@ fn finite_point(bad: &mut impl FnMut(String, String), key: &str, p: [f64; 2]) ->
     ok
 }
 
-fn check_wall(bad: &mut impl FnMut(String, String), key: &str, wall: &Wall) {
+pub(super) fn check_wall(bad: &mut impl FnMut(String, String), key: &str, wall: &Wall) {
     match wall {
         Wall::Box {
             center,
