@@ -175,16 +175,23 @@ impl Window {
             })),
             None if reach > half => {
                 let problem = coarse_problem((grid, reachable, w), agent, position, reach, &discs);
-                solve_problem(problem, agent, position, tolerance).ok().map(
-                    |(sampler, iterations)| {
+                match solve_problem(problem, agent, position, tolerance) {
+                    Ok((sampler, iterations)) => {
                         coarse_iterations = iterations;
-                        Arc::new(Coarse {
+                        Some(Arc::new(Coarse {
                             sampler: Arc::new(sampler),
                             centre: position,
                             reused: 0,
-                        })
-                    },
-                )
+                        }))
+                    }
+                    // The discs cut the agent off at the coarse cell: the fine window's ring
+                    // would hold the field of the walls as if nothing closed the way (a door
+                    // shutting in the window: the ring behind the agent then outweighs the
+                    // slit left, and the window leads away from the door). Whether a way
+                    // remains only the whole field can say.
+                    Err(FieldError::Unreachable { .. }) => return Err(unreachable()),
+                    Err(_) => None,
+                }
             }
             None => None,
         };
