@@ -1037,3 +1037,36 @@ fn a_robot_on_wheels_is_recorded_with_its_footprint_and_wheels() {
         "{stdout}"
     );
 }
+
+/// A moving obstacle is drawn where it is at each instant (its frame, a row a step, with its
+/// shape in it), with its path; the robot's guidance is re-logged as it replans around it.
+#[test]
+fn the_recording_shows_the_obstacles_where_they_are_and_the_guidance_as_it_replans() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("corridor-walker.toml");
+    let args = ["run", world.to_str().unwrap(), "--set", "duration=3"];
+    let out = nadf(
+        dir.path(),
+        &[&args[..], &["--set", "expect.reached=false", "-o", "w.rrd"]].concat(),
+    );
+    common::assert_success(&out);
+    let recording = Recording::read(&dir.path().join("w.rrd"));
+    recording.assert_has(&[
+        "world/obstacles/person/body",
+        "world/obstacles/person/body/shape",
+        "world/obstacles/person/path",
+    ]);
+    // 3 s at 10 ms: a pose per step, on the script: up from (6, 1) at 1.2 m/s.
+    let poses = recording.values::<3>("world/obstacles/person/body", "Transform3D:translation");
+    assert_eq!(poses.len(), 300);
+    for (ns, p) in &poses {
+        let t = *ns as f64 * 1e-9;
+        assert!(
+            (p[0] - 6.0).abs() < 1e-6 && (p[1] - (1.0 + 1.2 * t)).abs() < 1e-4,
+            "{t}: {p:?}"
+        );
+    }
+    // The guidance at the start and then about once a second of replanning.
+    let arrows = recording.rows("agents/robot/field/guidance", "Arrows2D:vectors");
+    assert!((3..=4).contains(&arrows), "{arrows}");
+}

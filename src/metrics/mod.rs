@@ -327,6 +327,11 @@ impl Metrics {
         self.resolves += 1;
     }
 
+    /// Successful re-solves of the harmonic field so far.
+    pub fn resolves(&self) -> usize {
+        self.resolves
+    }
+
     /// Counts an update of the bias β.
     pub fn record_bias_update(&mut self) {
         self.bias_updates += 1;

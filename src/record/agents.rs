@@ -53,6 +53,13 @@ pub fn log_setup(
                         ),
                     )?;
                 }
+            } else if replots_field(sim) {
+                // Re-solved whole around the moving obstacles: on the timeline (log_replanned).
+                rec.set_duration_secs(SIM_TIME, 0.0);
+                rec.log(
+                    paths.potential.as_str(),
+                    &rerun::Image::from_rgb24(image, resolution).with_draw_order(-10.0),
+                )?;
             } else {
                 rec.log_static(
                     paths.potential.as_str(),
@@ -60,9 +67,13 @@ pub fn log_setup(
                 )?;
             }
         }
-        // A lidar agent's arrows change with its field: re-logged with it (log_lidar).
-        if run.lidar.is_none() {
+        // A lidar agent's arrows change with its field: re-logged with it (log_lidar); so do
+        // those of an agent that replans around moving obstacles (log_replanned).
+        if run.lidar.is_none() && sim.obstacles.is_empty() {
             rec.log_static(paths.guidance, &arrows(sim, run))?;
+        } else if run.lidar.is_none() {
+            rec.set_duration_secs(SIM_TIME, 0.0);
+            rec.log(paths.guidance, &arrows(sim, run))?;
         }
         let path: Vec<[f32; 2]> = run.kinematic.points.iter().map(|p| f32x2(*p)).collect();
         rec.log_static(
@@ -94,6 +105,9 @@ pub struct Steps {
     columns: Vec<AgentColumns>,
     /// Per agent, the lidar field last logged (`LidarRun::fields`).
     fields_logged: Vec<usize>,
+    /// Per agent that replans around moving obstacles without a lidar: when its guidance was
+    /// last logged, s, and how many re-solves its field had then.
+    replans_logged: Vec<(f64, usize)>,
 }
 
 impl Steps {
@@ -107,6 +121,7 @@ impl Steps {
                 .map(|run| AgentColumns::new(rec, run))
                 .collect::<Result<_, _>>()?,
             fields_logged: vec![0; sim.agents.len()],
+            replans_logged: vec![(0.0, 0); sim.agents.len()],
         })
     }
 
@@ -121,10 +136,19 @@ impl Steps {
     ) -> Result<(), rerun::RecordingStreamError> {
         let mut sent = false;
         let agents = sim.agents.iter().zip(states);
-        for ((run, state), (columns, field_logged)) in
-            agents.zip(self.columns.iter_mut().zip(&mut self.fields_logged))
+        let logged = (self.fields_logged.iter_mut()).zip(&mut self.replans_logged);
+        for ((run, state), (columns, (field_logged, replan_logged))) in
+            agents.zip(self.columns.iter_mut().zip(logged))
         {
             log_events(rec, sim.time(), columns.paths(), state)?;
+            if run.lidar.is_none() && !sim.obstacles.is_empty() {
+                let (at, resolves) = *replan_logged;
+                let now = run.metrics.resolves();
+                if now != resolves && sim.time() >= at + REPLAN_IMAGE_EVERY {
+                    *replan_logged = (sim.time(), now);
+                    log_replanned(rec, columns.paths(), sim, run)?;
+                }
+            }
             if let Some(lidar) = &run.lidar {
                 let due = lidar.lidar.scans % LIDAR_IMAGE_EVERY == 1;
                 let new = *field_logged != lidar.fields;
@@ -178,6 +202,45 @@ fn thinned((image, [w, h]): (Vec<u8>, [u32; 2]), stride: usize) -> (Vec<u8>, [u3
 /// field than the first): at most [`LIDAR_IMAGE`] pixels a side.
 fn thumbnail_stride(grid: &crate::field::Grid) -> usize {
     grid.nx.max(grid.ny).div_ceil(LIDAR_IMAGE).max(1)
+}
+
+/// Simulated time between two logs of the guidance of an agent that replans around moving
+/// obstacles, s.
+const REPLAN_IMAGE_EVERY: f64 = 1.0;
+
+/// Whether the agents' field images are re-logged as their fields are re-solved: the whole
+/// field is re-solved around moving obstacles (`replan = "full"`; a local replan re-solves a
+/// window, which the image of the field of the walls does not show).
+fn replots_field(sim: &Simulation) -> bool {
+    !sim.obstacles.is_empty() && sim.world.field.replan == crate::world::Replan::Full
+}
+
+/// The guidance of an agent without a lidar that replans around moving obstacles, as its field
+/// is now (and the field's image, where the whole field is re-solved).
+fn log_replanned(
+    rec: &RecordingStream,
+    paths: &AgentPaths,
+    sim: &Simulation,
+    run: &AgentRun,
+) -> Result<(), rerun::RecordingStreamError> {
+    rec.set_duration_secs(SIM_TIME, sim.time());
+    rec.log(paths.guidance.as_str(), &arrows(sim, run))?;
+    if replots_field(sim)
+        && let Some(field) = run.field.harmonic()
+    {
+        let index = sim.agents.iter().position(|a| std::ptr::eq(a, run));
+        let stride = if index == Some(0) {
+            1
+        } else {
+            thumbnail_stride(field.grid())
+        };
+        let (image, size) = thinned(colormap::potential_image(field), stride);
+        rec.log(
+            paths.potential.as_str(),
+            &rerun::Image::from_rgb24(image, size).with_draw_order(-10.0),
+        )?;
+    }
+    Ok(())
 }
 
 /// The largest side of a lidar agent's map image, pixels (the image is re-logged as the map

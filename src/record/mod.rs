@@ -39,6 +39,11 @@
 //!   joint, per step, red while touching), `…/trail` (the tip's), `…/events`; and
 //!   `plots/NAME/{joints, torques}`.
 //!
+//! - `world/obstacles/NAME/body`: a moving obstacle's frame, its pose per step (in columns),
+//!   with `…/body/shape` its outline in that frame (static); `…/path` its waypoints, or the
+//!   region a wanderer stays in (static). An agent's `field/guidance` arrows are then logged
+//!   on the timeline, again once a second as its field is re-solved around the obstacles (and
+//!   with `replan = "full"` its `field/potential` too: the whole field is re-solved).
 //! - `summary`: the run's verdict (the summary table and the expectations), a text document.
 //! - `world/pendulums/NAME/{pivot, target, rod, bob}`: a pendulum; `…/events` its bias updates
 //!   (INFO); `plots/NAME/{theta, torque, bias}`: (θ(t), θ_T), u(t) and β(t).
@@ -49,9 +54,10 @@
 //! The recording is written to `OUT.rrd.partial` and renamed to `OUT.rrd` once complete, so an
 //! existing recording is never replaced by a broken one.
 //!
-//! The files: `world.rs` (the geometry), `agents.rs`, `pendulums.rs`, `blueprint.rs` (the
-//! layout), with every entity and series name in one table (`names.rs`) and every colour in
-//! one palette (`palette.rs`); `colormap.rs` and `picture.rs` draw a field as an image.
+//! The files: `world.rs` (the geometry), `agents.rs`, `obstacles.rs`, `pendulums.rs`,
+//! `blueprint.rs` (the layout), with every entity and series name in one table (`names.rs`) and
+//! every colour in one palette (`palette.rs`); `colormap.rs` and `picture.rs` draw a field as an
+//! image.
 
 mod agents;
 mod arms;
@@ -59,6 +65,7 @@ mod blueprint;
 mod colormap;
 mod columns;
 mod names;
+mod obstacles;
 mod palette;
 mod pendulums;
 mod picture;
@@ -156,6 +163,7 @@ pub struct Recorder {
     steps: agents::Steps,
     shaped: shaped::ShapedSteps,
     arms: arms::ArmSteps,
+    obstacles: obstacles::ObstacleSteps,
     last_flush: std::time::Instant,
 }
 
@@ -216,6 +224,7 @@ impl Recorder {
             steps: agents::Steps::default(),
             shaped: shaped::ShapedSteps::default(),
             arms: arms::ArmSteps::default(),
+            obstacles: obstacles::ObstacleSteps::default(),
             last_flush: std::time::Instant::now(),
         })
     }
@@ -228,6 +237,7 @@ impl Recorder {
         self.steps = agents::Steps::new(&self.stream, sim)?;
         self.shaped = shaped::log_setup(&self.stream, sim)?;
         self.arms = arms::log_setup(&self.stream, &sim.arms)?;
+        self.obstacles = obstacles::log_setup(&self.stream, &sim.obstacles)?;
         if let Some(layout) = self.layout.take() {
             blueprint::send(&self.stream, layout)?;
         }
@@ -253,8 +263,10 @@ impl Recorder {
         self.arms
             .log_step(rec, sim.time(), &sim.arms, sim.finished())?;
         self.steps.log_step(rec, sim, states, sim.finished())?;
+        (self.obstacles).log_step(rec, sim.time(), &sim.obstacles, sim.finished())?;
         if self.last_flush.elapsed() >= FLUSH_EVERY {
             self.steps.send(rec, false)?;
+            self.obstacles.send(rec)?;
             // A failed flush is not fatal here: the next one, or the footer, retries.
             let _ = self.stream.flush_blocking();
             self.last_flush = std::time::Instant::now();
@@ -279,10 +291,12 @@ impl Recorder {
             stream,
             file,
             mut steps,
+            mut obstacles,
             ..
         } = self;
         let flushed = steps
             .send(&stream, true)
+            .and_then(|()| obstacles.send(&stream))
             .map_err(|e| e.to_string())
             .and_then(|()| stream.flush_blocking().map_err(|e| e.to_string()));
         if let Err(message) = flushed {

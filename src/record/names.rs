@@ -95,6 +95,28 @@ impl AgentPaths {
     }
 }
 
+/// One moving obstacle's entities, under `world/obstacles/NAME/`.
+pub struct ObstaclePaths {
+    /// Its frame: the pose per step (translation and rotation).
+    pub body: String,
+    /// Its shape's outline in that frame (static).
+    pub shape: String,
+    /// Its path, or the region a wanderer stays in (static).
+    pub path: String,
+}
+
+impl ObstaclePaths {
+    /// The entities of the obstacle called `name`.
+    pub fn of(name: &str) -> Self {
+        let path = |part: &str| format!("{WORLD}/obstacles/{name}/{part}");
+        Self {
+            body: path("body"),
+            shape: path("body/shape"),
+            path: path("path"),
+        }
+    }
+}
+
 /// One shaped agent's entities (under `agents/NAME/`, as a disc's).
 pub struct ShapedPaths {
     /// `log10(1 − V)` of the slice of its field at its current heading, as an image.

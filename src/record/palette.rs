@@ -40,6 +40,9 @@ pub const BLOCKED: Rgb = [70, 70, 70];
 /// Free cells of a field image from which the target cannot be reached.
 pub const UNREACHABLE: Rgb = [0, 0, 0];
 
+/// A moving obstacle, and (translucent) its path.
+pub const OBSTACLE: Rgb = [190, 120, 255];
+
 /// A map's walls (drawn as an image).
 pub const MAP_WALL: Rgb = [150, 150, 150];
 /// A map's unknown cells.
