@@ -327,6 +327,11 @@ impl Metrics {
         self.resolves += 1;
     }
 
+    /// Contact starts so far.
+    pub fn contacts(&self) -> usize {
+        self.contacts
+    }
+
     /// Successful re-solves of the harmonic field so far.
     pub fn resolves(&self) -> usize {
         self.resolves

@@ -1,0 +1,337 @@
+//! `nadf._nadf`: the extension module behind the Python package `nadf` (`python/nadf/`).
+//!
+//! Everything here calls the crate: a world is loaded by `nadf::world::load`, run by
+//! `nadf::run::run` (so a summary is the CLI's `--json`, byte for byte before parsing), stepped
+//! by `nadf::sim::Simulation`, and a field is exported by `nadf::field::export` (the `.npy`
+//! bytes `nadf field --npy` writes). The Python package turns lists and `.npy` bytes into
+//! NumPy arrays; no law, field or metric is computed twice.
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use pyo3::create_exception;
+use pyo3::exceptions::{PyIndexError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+
+use nadf::field::export;
+use nadf::sim::AgentState;
+use nadf::world::Override;
+
+create_exception!(
+    _nadf,
+    WorldError,
+    PyValueError,
+    "A world file that does not load: its message names the file, the line and the key, as \
+     `nadf check` does."
+);
+create_exception!(
+    _nadf,
+    RunError,
+    PyRuntimeError,
+    "A run that cannot be done: a target no path reaches, a field that cannot be built, an \
+     output that cannot be written."
+);
+
+/// The `--set KEY=VALUE` overrides `set`, parsed.
+fn overrides(set: Option<Vec<String>>) -> PyResult<Vec<Override>> {
+    (set.unwrap_or_default().iter())
+        .map(|s| {
+            s.parse::<Override>()
+                .map_err(|e| WorldError::new_err(format!("--set {s}: {e}")))
+        })
+        .collect()
+}
+
+/// A world file loaded (with its overrides) and checked.
+#[pyclass(module = "nadf._nadf", frozen)]
+struct World {
+    world: nadf::world::World,
+    path: PathBuf,
+}
+
+#[pymethods]
+impl World {
+    /// The world's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.world.name().to_string()
+    }
+
+    /// The file it was loaded from.
+    #[getter]
+    fn path(&self) -> PathBuf {
+        self.path.clone()
+    }
+
+    /// Physics step, s.
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.world.dt
+    }
+
+    /// Simulated time of a run, s.
+    #[getter]
+    fn duration(&self) -> f64 {
+        self.world.duration
+    }
+
+    /// Physics steps in a run.
+    #[getter]
+    fn steps(&self) -> usize {
+        self.world.steps()
+    }
+
+    /// The seed of everything random in a run.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.world.seed
+    }
+
+    /// The box's lower-left and upper-right corners, m.
+    #[getter]
+    fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        self.world.bounds()
+    }
+
+    /// The disc agents' names, in the file's order (the rows of a simulation's arrays).
+    #[getter]
+    fn agents(&self) -> Vec<String> {
+        self.world.agents.iter().map(|a| a.name.clone()).collect()
+    }
+
+    /// The moving obstacles' names.
+    #[getter]
+    fn obstacles(&self) -> Vec<String> {
+        (self.world.obstacles.iter().enumerate())
+            .map(|(i, o)| o.name_or(i))
+            .collect()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "World({:?}: {} agent(s), {} s at dt = {} s)",
+            self.world.name(),
+            self.world.agents.len(),
+            self.world.duration,
+            self.world.dt
+        )
+    }
+}
+
+/// Loads the world file at `path` with the overrides `set` (`["field.cell=0.1", ...]`).
+#[pyfunction]
+#[pyo3(signature = (path, set = None))]
+fn load(path: PathBuf, set: Option<Vec<String>>) -> PyResult<World> {
+    let sets = overrides(set)?;
+    let world = nadf::world::load(&path, &sets).map_err(|e| WorldError::new_err(e.to_string()))?;
+    Ok(World { world, path })
+}
+
+/// Runs the world file at `path` to its duration, as `nadf run` does (writing the recording
+/// `record` if given), and returns its summary as the JSON text `nadf run --json` writes.
+/// The run releases the GIL.
+#[pyfunction]
+#[pyo3(signature = (path, set = None, record = None))]
+fn run_json(
+    py: Python<'_>,
+    path: PathBuf,
+    set: Option<Vec<String>>,
+    record: Option<PathBuf>,
+) -> PyResult<String> {
+    let World { world, .. } = load(path, set)?;
+    let options = nadf::run::RunOptions {
+        recording: record,
+        ..Default::default()
+    };
+    let report = py
+        .detach(|| nadf::run::run(&world, &options))
+        .map_err(|e| RunError::new_err(e.to_string()))?;
+    Ok(report.to_json())
+}
+
+/// A running simulation of a world's disc agents.
+#[pyclass(module = "nadf._nadf", frozen)]
+struct Simulation {
+    inner: Mutex<Running>,
+}
+
+/// The simulation and each agent's state after the last step (none before the first).
+struct Running {
+    sim: nadf::sim::Simulation,
+    states: Vec<AgentState>,
+}
+
+impl Simulation {
+    fn with<T>(&self, f: impl FnOnce(&mut Running) -> T) -> T {
+        let mut running = self.inner.lock().unwrap_or_else(|e| e.into_inner());
+        f(&mut running)
+    }
+}
+
+#[pymethods]
+impl Simulation {
+    /// Builds the world's Rapier world and solves every agent's field.
+    #[new]
+    fn new(py: Python<'_>, world: &World) -> PyResult<Self> {
+        let world = &world.world;
+        let intractable = nadf::field::FreeSpace::intractable(world);
+        if !intractable.is_empty() {
+            let messages: Vec<String> = intractable.iter().map(ToString::to_string).collect();
+            return Err(RunError::new_err(messages.join("\n")));
+        }
+        let sim = py
+            .detach(|| nadf::sim::Simulation::new(world))
+            .map_err(|e| RunError::new_err(e.to_string()))?;
+        Ok(Self {
+            inner: Mutex::new(Running {
+                sim,
+                states: Vec::new(),
+            }),
+        })
+    }
+
+    /// Advances `n` physics steps (the GIL released while they run); returns the time, s.
+    #[pyo3(signature = (n = 1))]
+    fn step(&self, py: Python<'_>, n: usize) -> f64 {
+        py.detach(|| {
+            self.with(|r| {
+                for _ in 0..n {
+                    r.states = r.sim.step();
+                }
+                r.sim.time()
+            })
+        })
+    }
+
+    /// Simulated time, s.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.with(|r| r.sim.time())
+    }
+
+    /// Whether the run has reached the world's duration.
+    #[getter]
+    fn finished(&self) -> bool {
+        self.with(|r| r.sim.finished())
+    }
+
+    /// Each agent's position, m (its start before the first step).
+    fn positions(&self) -> Vec<[f64; 2]> {
+        self.with(|r| {
+            (r.sim.agents.iter().enumerate())
+                .map(|(i, a)| match r.states.get(i) {
+                    Some(s) => s.position.into(),
+                    None => a.agent.start,
+                })
+                .collect()
+        })
+    }
+
+    /// Each agent's velocity, m/s.
+    fn velocities(&self) -> Vec<[f64; 2]> {
+        self.with(|r| {
+            (r.sim.agents.iter().enumerate())
+                .map(|(i, a)| match r.states.get(i) {
+                    Some(s) => s.velocity.into(),
+                    None => a.agent.initial_velocity,
+                })
+                .collect()
+        })
+    }
+
+    /// The control force each agent applied in the last step, N (zero before the first).
+    fn forces(&self) -> Vec<[f64; 2]> {
+        self.with(|r| {
+            (0..r.sim.agents.len())
+                .map(|i| r.states.get(i).map_or([0.0, 0.0], |s| s.force.into()))
+                .collect()
+        })
+    }
+
+    /// Each agent's heading, rad: a robot on wheels' own, another's the direction of its
+    /// velocity (0 at rest).
+    fn headings(&self) -> Vec<f64> {
+        self.with(|r| {
+            (r.sim.agents.iter().enumerate())
+                .map(|(i, a)| match r.states.get(i) {
+                    Some(AgentState {
+                        axle: Some((_, heading)),
+                        ..
+                    }) => *heading,
+                    Some(s) if s.velocity.norm() > 0.0 => s.velocity.y.atan2(s.velocity.x),
+                    Some(_) => 0.0,
+                    None => a.agent.heading,
+                })
+                .collect()
+        })
+    }
+
+    /// Contact starts of each agent so far (against anything).
+    fn contacts(&self) -> Vec<usize> {
+        self.with(|r| r.sim.agents.iter().map(|a| a.metrics.contacts()).collect())
+    }
+
+    /// Whether each agent touches something now.
+    fn touching(&self) -> Vec<bool> {
+        self.with(|r| {
+            (0..r.sim.agents.len())
+                .map(|i| {
+                    r.states
+                        .get(i)
+                        .is_some_and(|s| !s.contact_points.is_empty())
+                })
+                .collect()
+        })
+    }
+
+    /// Each agent's summary so far, as the JSON text of a summary's `agents` (a list).
+    fn summaries_json(&self) -> String {
+        self.with(|r| serde_json::to_string(&r.sim.summaries()).expect("plain data"))
+    }
+
+    /// The `.npy` files of agent `agent`'s current harmonic field, as `nadf field --npy`
+    /// writes them: `V`, `1 − V`, `log10(1 − V)` and the mask, each `[nx, ny]`, and the grid's
+    /// origin and cell, m.
+    #[allow(clippy::type_complexity)]
+    fn field_npy<'py>(
+        &self,
+        py: Python<'py>,
+        agent: usize,
+    ) -> PyResult<([Bound<'py, PyBytes>; 4], [f64; 2], f64)> {
+        self.with(|r| {
+            let run = r.sim.agents.get(agent).ok_or_else(|| {
+                PyIndexError::new_err(format!(
+                    "agent {agent}: the world has {} agent(s)",
+                    r.sim.agents.len()
+                ))
+            })?;
+            let field = run.field.harmonic().ok_or_else(|| {
+                PyValueError::new_err(format!(
+                    "agent `{}` has no harmonic field (an attractive-repulsive potential has no grid)",
+                    run.agent.name
+                ))
+            })?;
+            let arrays = [
+                export::potential_npy(field),
+                export::one_minus_potential_npy(field),
+                export::log10_one_minus_potential_npy(field),
+                export::mask_npy(field),
+            ]
+            .map(|bytes| PyBytes::new(py, &bytes));
+            Ok((arrays, field.grid().origin, field.grid().cell))
+        })
+    }
+}
+
+/// The extension module.
+#[pymodule]
+fn _nadf(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(run_json, m)?)?;
+    m.add_class::<World>()?;
+    m.add_class::<Simulation>()?;
+    m.add("WorldError", m.py().get_type::<WorldError>())?;
+    m.add("RunError", m.py().get_type::<RunError>())?;
+    Ok(())
+}
