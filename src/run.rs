@@ -223,32 +223,7 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         bar.finish_and_clear();
     }
     if let Some(r) = &mut recorder {
-        let summaries = sim.summaries();
-        let shaped = sim.shaped_summaries();
-        let arms = sim.arm_summaries();
-        let mut failures = crate::expect::failures(world, &summaries);
-        failures.extend(crate::expect::shaped_failures(world, &shaped));
-        failures.extend(crate::expect::arm_failures(world, &arms));
-        let mut markdown = format!(
-            "```\n{}{}{}{}```\n\n",
-            metrics::table(&summaries),
-            shaped_table(&shaped),
-            arm_table(&arms),
-            drive_table(&sim.drive_summaries())
-        );
-        markdown += &match (interrupted_at, failures.is_empty()) {
-            (Some(t), _) => format!("**Interrupted** at {t:.2} s.\n"),
-            (None, true) => "No expectation failed.\n".to_string(),
-            (None, false) => format!(
-                "**{} expectation(s) failed:**\n\n{}\n",
-                failures.len(),
-                failures
-                    .iter()
-                    .map(|f| format!("- {f}"))
-                    .collect::<Vec<_>>()
-                    .join("\n")
-            ),
-        };
+        let markdown = verdict(world, &sim, interrupted_at);
         if let Err(e) = r.log_summary(&markdown) {
             recorder.take().expect("present").abandon();
             return Err(e.into());
@@ -271,6 +246,38 @@ pub fn run(world: &World, options: &RunOptions) -> Result<Report, RunError> {
         output::write_atomically(path, report.to_json().as_bytes())?;
     }
     Ok(report)
+}
+
+/// The run's verdict as markdown, for the recording: the summary tables of `sim` so far and
+/// the expectations of `world` that failed (or that the run was interrupted at the time given).
+pub fn verdict(world: &World, sim: &Simulation, interrupted_at: Option<f64>) -> String {
+    let summaries = sim.summaries();
+    let shaped = sim.shaped_summaries();
+    let arms = sim.arm_summaries();
+    let mut failures = crate::expect::failures(world, &summaries);
+    failures.extend(crate::expect::shaped_failures(world, &shaped));
+    failures.extend(crate::expect::arm_failures(world, &arms));
+    let mut markdown = format!(
+        "```\n{}{}{}{}```\n\n",
+        metrics::table(&summaries),
+        shaped_table(&shaped),
+        arm_table(&arms),
+        drive_table(&sim.drive_summaries())
+    );
+    markdown += &match (interrupted_at, failures.is_empty()) {
+        (Some(t), _) => format!("**Interrupted** at {t:.2} s.\n"),
+        (None, true) => "No expectation failed.\n".to_string(),
+        (None, false) => format!(
+            "**{} expectation(s) failed:**\n\n{}\n",
+            failures.len(),
+            failures
+                .iter()
+                .map(|f| format!("- {f}"))
+                .collect::<Vec<_>>()
+                .join("\n")
+        ),
+    };
+    markdown
 }
 
 /// The wheels' summaries as a table.

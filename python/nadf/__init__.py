@@ -39,18 +39,25 @@ def run(
     path: PathLike,
     set: Optional[Sequence[str]] = None,
     record: Optional[PathLike] = None,
+    spawn: bool = False,
+    connect: Optional[str] = None,
 ) -> dict:
     """Runs the world file at ``path`` to its duration, as ``nadf run`` does, and returns its
-    summary: the dictionary ``nadf run --json`` writes. With ``record``, the Rerun recording is
-    written there too. The run releases the GIL.
+    summary: the dictionary ``nadf run --json`` writes. The recording as the CLI's options:
+    ``record`` writes it to that file, ``spawn=True`` starts a Rerun viewer and streams into it,
+    ``connect`` streams to the viewer at that URL (``"rerun+http://127.0.0.1:9876/proxy"``).
+    The run releases the GIL.
 
     Raises :class:`WorldError` for a file that does not load, :class:`RunError` for a run that
-    cannot be done (a target no path reaches, an output that cannot be written).
+    cannot be done (a target no path reaches, an output that cannot be written, no viewer at
+    ``connect``).
     """
     text = _nadf.run_json(
         os.fspath(path),
         None if set is None else list(set),
         None if record is None else os.fspath(record),
+        spawn,
+        connect,
     )
     return json.loads(text)
 
@@ -61,19 +68,42 @@ class Simulation:
     Arrays have one row per agent, in the world file's order (``world.agents``).
     """
 
-    def __init__(self, world: Union[World, PathLike], set: Optional[Sequence[str]] = None):
+    def __init__(
+        self,
+        world: Union[World, PathLike],
+        set: Optional[Sequence[str]] = None,
+        record: Optional[PathLike] = None,
+        spawn: bool = False,
+        connect: Optional[str] = None,
+    ):
+        """Builds the simulation of ``world`` (a :class:`World`, or a path loaded with ``set``).
+        With ``record``, ``spawn`` or ``connect`` (as :func:`run`'s), every step is recorded
+        until :meth:`close` (or the end of a ``with`` block, or the object's end)."""
         if not isinstance(world, World):
             world = load(world, set)
         elif set is not None:
             raise TypeError("`set` is for a path; a loaded World already has its overrides")
         self.world: World = world
-        self._sim = _nadf.Simulation(world)
+        self._sim = _nadf.Simulation(
+            world, None if record is None else os.fspath(record), spawn, connect
+        )
 
     def step(self, n: int = 1) -> float:
         """Advances ``n`` physics steps (the GIL released while they run); returns the time, s."""
         if n < 0:
             raise ValueError(f"n must be at least 0, got {n}")
         return self._sim.step(n)
+
+    def close(self) -> Optional[str]:
+        """Ends the recording, if any: its verdict logged (interrupted, if the run has not
+        reached its duration) and the file moved into place. Returns the file."""
+        return self._sim.close()
+
+    def __enter__(self) -> "Simulation":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     @property
     def time(self) -> float:

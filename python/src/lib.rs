@@ -15,6 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
 use nadf::field::export;
+use nadf::record::{Recorder, Viewer};
 use nadf::sim::AgentState;
 use nadf::world::Override;
 
@@ -128,20 +129,24 @@ fn load(path: PathBuf, set: Option<Vec<String>>) -> PyResult<World> {
     Ok(World { world, path })
 }
 
-/// Runs the world file at `path` to its duration, as `nadf run` does (writing the recording
-/// `record` if given), and returns its summary as the JSON text `nadf run --json` writes.
-/// The run releases the GIL.
+/// Runs the world file at `path` to its duration, as `nadf run` does, and returns its summary
+/// as the JSON text `nadf run --json` writes. As the CLI's options: the recording `record` (a
+/// file), `spawn` (start a Rerun viewer and stream into it), `connect` (stream to the viewer
+/// at that URL). The run releases the GIL.
 #[pyfunction]
-#[pyo3(signature = (path, set = None, record = None))]
+#[pyo3(signature = (path, set = None, record = None, spawn = false, connect = None))]
 fn run_json(
     py: Python<'_>,
     path: PathBuf,
     set: Option<Vec<String>>,
     record: Option<PathBuf>,
+    spawn: bool,
+    connect: Option<String>,
 ) -> PyResult<String> {
     let World { world, .. } = load(path, set)?;
     let options = nadf::run::RunOptions {
         recording: record,
+        viewer: viewer(spawn, connect),
         ..Default::default()
     };
     let report = py
@@ -156,10 +161,50 @@ struct Simulation {
     inner: Mutex<Running>,
 }
 
-/// The simulation and each agent's state after the last step (none before the first).
+/// The simulation, each agent's state after the last step (none before the first), and the
+/// recording being written or streamed, if any.
 struct Running {
     sim: nadf::sim::Simulation,
     states: Vec<AgentState>,
+    recorder: Option<Recorder>,
+}
+
+impl Running {
+    /// Ends the recording, if any: the verdict so far logged (interrupted, if the run has not
+    /// reached its duration), the file moved into place; returns the file.
+    fn close(&mut self) -> PyResult<Option<PathBuf>> {
+        let Some(mut recorder) = self.recorder.take() else {
+            return Ok(None);
+        };
+        let world = &self.sim.world;
+        let at = (!self.sim.finished()).then(|| self.sim.time());
+        if let Err(e) = recorder.log_summary(&nadf::run::verdict(world, &self.sim, at)) {
+            recorder.abandon();
+            return Err(RunError::new_err(format!(
+                "writing the recording failed: {e}"
+            )));
+        }
+        recorder
+            .finish()
+            .map_err(|e| RunError::new_err(e.to_string()))
+    }
+}
+
+impl Drop for Running {
+    /// A simulation dropped with its recording open still leaves a complete file (up to where
+    /// it was stepped), never a `.partial` one.
+    fn drop(&mut self) {
+        let _ = self.close();
+    }
+}
+
+/// The viewer of the CLI's `--spawn` and `--connect URL`.
+fn viewer(spawn: bool, connect: Option<String>) -> Option<Viewer> {
+    match (connect, spawn) {
+        (Some(url), _) => Some(Viewer::Connect(url)),
+        (None, true) => Some(Viewer::Spawn),
+        (None, false) => None,
+    }
 }
 
 impl Simulation {
@@ -171,10 +216,22 @@ impl Simulation {
 
 #[pymethods]
 impl Simulation {
-    /// Builds the world's Rapier world and solves every agent's field.
+    /// Builds the world's Rapier world and solves every agent's field; with `record`, `spawn`
+    /// or `connect` (as `run_json`'s), every step is recorded until `close`.
     #[new]
-    fn new(py: Python<'_>, world: &World) -> PyResult<Self> {
+    #[pyo3(signature = (world, record = None, spawn = false, connect = None))]
+    fn new(
+        py: Python<'_>,
+        world: &World,
+        record: Option<PathBuf>,
+        spawn: bool,
+        connect: Option<String>,
+    ) -> PyResult<Self> {
         let world = &world.world;
+        let viewer = viewer(spawn, connect);
+        if let Some(path) = &record {
+            nadf::output::check_file(path).map_err(|e| RunError::new_err(e.to_string()))?;
+        }
         let intractable = nadf::field::FreeSpace::intractable(world);
         if !intractable.is_empty() {
             let messages: Vec<String> = intractable.iter().map(ToString::to_string).collect();
@@ -183,25 +240,57 @@ impl Simulation {
         let sim = py
             .detach(|| nadf::sim::Simulation::new(world))
             .map_err(|e| RunError::new_err(e.to_string()))?;
+        let recorder = match (&record, &viewer) {
+            (None, None) => None,
+            (path, viewer) => {
+                let mut r = Recorder::create(path.as_deref(), viewer.as_ref(), world)
+                    .map_err(|e| RunError::new_err(e.to_string()))?;
+                if let Err(e) = r.log_setup(&sim) {
+                    r.abandon();
+                    return Err(RunError::new_err(format!(
+                        "writing the recording failed: {e}"
+                    )));
+                }
+                Some(r)
+            }
+        };
         Ok(Self {
             inner: Mutex::new(Running {
                 sim,
                 states: Vec::new(),
+                recorder,
             }),
         })
     }
 
-    /// Advances `n` physics steps (the GIL released while they run); returns the time, s.
+    /// Advances `n` physics steps (the GIL released while they run), recording each if the
+    /// simulation records; returns the time, s.
     #[pyo3(signature = (n = 1))]
-    fn step(&self, py: Python<'_>, n: usize) -> f64 {
+    fn step(&self, py: Python<'_>, n: usize) -> PyResult<f64> {
         py.detach(|| {
             self.with(|r| {
                 for _ in 0..n {
                     r.states = r.sim.step();
+                    if let Some(recorder) = &mut r.recorder
+                        && let Err(e) = recorder.log_step(&r.sim, &r.states)
+                    {
+                        if let Some(recorder) = r.recorder.take() {
+                            recorder.abandon();
+                        }
+                        return Err(RunError::new_err(format!(
+                            "writing the recording failed: {e}"
+                        )));
+                    }
                 }
-                r.sim.time()
+                Ok(r.sim.time())
             })
         })
+    }
+
+    /// Ends the recording, if any (its verdict logged, the file moved into place) and returns
+    /// the file; the simulation may step on, unrecorded.
+    fn close(&self, py: Python<'_>) -> PyResult<Option<PathBuf>> {
+        py.detach(|| self.with(Running::close))
     }
 
     /// Simulated time, s.

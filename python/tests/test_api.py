@@ -43,6 +43,29 @@ def test_a_run_writes_its_recording(tmp_path):
     summary = nadf.run(ROOM, set=COARSE, record=rrd)
     assert rrd.stat().st_size > 10_000
     assert summary["world"] == "room-two-dividers"
+    # Streaming goes through the CLI's checks: nothing listens on port 1.
+    with pytest.raises(nadf.RunError, match="no Rerun viewer is listening"):
+        nadf.run(ROOM, set=COARSE, connect="rerun+http://127.0.0.1:1/proxy")
+    with pytest.raises(nadf.RunError, match="cannot stream"):
+        nadf.run(ROOM, set=COARSE, connect="http://nowhere")
+
+
+def test_a_stepped_simulation_records_until_it_is_closed(tmp_path):
+    rrd = tmp_path / "stepped.rrd"
+    with nadf.Simulation(ROOM, set=COARSE, record=rrd) as sim:
+        sim.step(120)
+        assert not rrd.exists()  # still being written
+    assert rrd.stat().st_size > 10_000
+    assert not (tmp_path / "stepped.rrd.partial").exists()
+    assert sim.close() is None  # closed once
+    # Dropped without closing: the file is complete all the same.
+    dropped = tmp_path / "dropped.rrd"
+    sim = nadf.Simulation(ROOM, set=COARSE, record=dropped)
+    sim.step(10)
+    del sim
+    assert dropped.stat().st_size > 10_000
+    with pytest.raises(nadf.RunError, match="directory"):
+        nadf.Simulation(ROOM, set=COARSE, record=tmp_path / "missing" / "x.rrd")
 
 
 def test_a_world_describes_itself():
