@@ -16,7 +16,7 @@ use pyo3::types::PyBytes;
 
 use nadf::field::export;
 use nadf::record::{Recorder, Viewer};
-use nadf::sim::AgentState;
+use nadf::sim::{AgentRun, AgentState};
 use nadf::world::Override;
 
 create_exception!(
@@ -212,6 +212,15 @@ impl Simulation {
         let mut running = self.inner.lock().unwrap_or_else(|e| e.into_inner());
         f(&mut running)
     }
+
+    /// `f` of each agent and its state after the last step (none before the first), in order.
+    fn per_agent<T>(&self, f: impl Fn(&AgentRun, Option<&AgentState>) -> T) -> Vec<T> {
+        self.with(|r| {
+            (r.sim.agents.iter().enumerate())
+                .map(|(i, a)| f(a, r.states.get(i)))
+                .collect()
+        })
+    }
 }
 
 #[pymethods]
@@ -307,52 +316,30 @@ impl Simulation {
 
     /// Each agent's position, m (its start before the first step).
     fn positions(&self) -> Vec<[f64; 2]> {
-        self.with(|r| {
-            (r.sim.agents.iter().enumerate())
-                .map(|(i, a)| match r.states.get(i) {
-                    Some(s) => s.position.into(),
-                    None => a.agent.start,
-                })
-                .collect()
-        })
+        self.per_agent(|a, s| s.map_or(a.agent.start, |s| s.position.into()))
     }
 
     /// Each agent's velocity, m/s.
     fn velocities(&self) -> Vec<[f64; 2]> {
-        self.with(|r| {
-            (r.sim.agents.iter().enumerate())
-                .map(|(i, a)| match r.states.get(i) {
-                    Some(s) => s.velocity.into(),
-                    None => a.agent.initial_velocity,
-                })
-                .collect()
-        })
+        self.per_agent(|a, s| s.map_or(a.agent.initial_velocity, |s| s.velocity.into()))
     }
 
     /// The control force each agent applied in the last step, N (zero before the first).
     fn forces(&self) -> Vec<[f64; 2]> {
-        self.with(|r| {
-            (0..r.sim.agents.len())
-                .map(|i| r.states.get(i).map_or([0.0, 0.0], |s| s.force.into()))
-                .collect()
-        })
+        self.per_agent(|_, s| s.map_or([0.0, 0.0], |s| s.force.into()))
     }
 
     /// Each agent's heading, rad: a robot on wheels' own, another's the direction of its
     /// velocity (0 at rest).
     fn headings(&self) -> Vec<f64> {
-        self.with(|r| {
-            (r.sim.agents.iter().enumerate())
-                .map(|(i, a)| match r.states.get(i) {
-                    Some(AgentState {
-                        axle: Some((_, heading)),
-                        ..
-                    }) => *heading,
-                    Some(s) if s.velocity.norm() > 0.0 => s.velocity.y.atan2(s.velocity.x),
-                    Some(_) => 0.0,
-                    None => a.agent.heading,
-                })
-                .collect()
+        self.per_agent(|a, s| match s {
+            Some(AgentState {
+                axle: Some((_, heading)),
+                ..
+            }) => *heading,
+            Some(s) if s.velocity.norm() > 0.0 => s.velocity.y.atan2(s.velocity.x),
+            Some(_) => 0.0,
+            None => a.agent.heading,
         })
     }
 
@@ -363,15 +350,7 @@ impl Simulation {
 
     /// Whether each agent touches something now.
     fn touching(&self) -> Vec<bool> {
-        self.with(|r| {
-            (0..r.sim.agents.len())
-                .map(|i| {
-                    r.states
-                        .get(i)
-                        .is_some_and(|s| !s.contact_points.is_empty())
-                })
-                .collect()
-        })
+        self.per_agent(|_, s| s.is_some_and(|s| !s.contact_points.is_empty()))
     }
 
     /// Each agent's summary so far, as the JSON text of a summary's `agents` (a list).
