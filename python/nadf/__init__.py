@@ -94,6 +94,14 @@ class Simulation:
             raise ValueError(f"n must be at least 0, got {n}")
         return self._sim.step(n)
 
+    def command(self, agent: int, force: Optional[Sequence[float]]) -> None:
+        """Applies ``force`` (N, ``[fx, fy]``) to agent ``agent`` from the next step on instead of
+        its control law's, until ``None`` gives control back. The law still runs (its bias or
+        clamp moves on); the clearance envelope, when on, still keeps the body off the walls;
+        the speed limit and ``max_force`` do not apply. Raises ``ValueError`` for a force that
+        is not finite."""
+        self._sim.command(agent, None if force is None else [float(f) for f in force])
+
     def close(self) -> Optional[str]:
         """Ends the recording, if any: its verdict logged (interrupted, if the run has not
         reached its duration) and the file moved into place. Returns the file."""

@@ -296,6 +296,26 @@ impl Simulation {
         })
     }
 
+    /// Commands the force applied to agent `agent` from the next step on, N (`None`: its law
+    /// drives it again); see `AgentRun::command`.
+    #[pyo3(signature = (agent, force = None))]
+    fn command(&self, agent: usize, force: Option<[f64; 2]>) -> PyResult<()> {
+        self.with(|r| {
+            let count = r.sim.agents.len();
+            let run = r.sim.agents.get_mut(agent).ok_or_else(|| {
+                PyIndexError::new_err(format!("agent {agent}: the world has {count} agent(s)"))
+            })?;
+            if run.command(force.map(nalgebra::Vector2::from)) {
+                Ok(())
+            } else {
+                Err(PyValueError::new_err(format!(
+                    "agent `{}` cannot be commanded {force:?} N: a force must be finite, and a robot under the unicycle law commands its wheels itself",
+                    run.agent.name
+                )))
+            }
+        })
+    }
+
     /// Ends the recording, if any (its verdict logged, the file moved into place) and returns
     /// the file; the simulation may step on, unrecorded.
     fn close(&self, py: Python<'_>) -> PyResult<Option<PathBuf>> {

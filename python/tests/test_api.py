@@ -141,3 +141,32 @@ def test_a_run_is_deterministic_and_steps_add_up():
     a.step(a.world.steps - 150)
     assert a.finished
     assert a.summaries() == nadf.run(ROOM, set=COARSE)["agents"]
+
+
+def test_a_commanded_force_drives_the_body_instead_of_its_law(tmp_path):
+    world = tmp_path / "open.toml"
+    world.write_text(
+        'size = [20.0, 10.0]\nduration = 5.0\n[field]\ncell = 0.1\n\n[[agents]]\nname = "r"\n'
+        'start = [2.0, 5.0]\ntarget = [18.0, 5.0]\nmass = 2.0\n'
+        'controller = { kind = "nadf", b = 10.0, k = 1.0 }\n'
+    )
+    sim = nadf.Simulation(world)
+    sim.command(0, [4.0, 1.0])
+    sim.step(100)
+    # 1 s of 4 N and 1 N on 2 kg from rest: v = a t = (2, 0.5) m/s, and x − x0 = a t² / 2 to
+    # within the step (between the explicit and the semi-implicit Euler sums,
+    # a dt² n (n ∓ 1) / 2: Rapier's substeps land in between).
+    a = np.array([2.0, 0.5])
+    assert np.allclose(sim.velocity[0], a * 1.0, atol=1e-4)
+    moved = sim.position[0] - [2.0, 5.0]
+    assert (moved > a * 0.01**2 * 100 * 99 / 2).all() and (moved < a * 0.01**2 * 100 * 101 / 2).all()
+    assert np.allclose(sim.force[0], [4.0, 1.0])
+    # Control back to the law: NADF damps the sideways motion the command left.
+    sim.command(0, None)
+    sim.step(50)
+    assert abs(sim.velocity[0][1]) < 0.5 * 0.5
+    assert not np.allclose(sim.force[0], [4.0, 1.0])
+    with pytest.raises(ValueError, match="must be finite"):
+        sim.command(0, [float("nan"), 0.0])
+    with pytest.raises(IndexError):
+        sim.command(1, [0.0, 0.0])

@@ -82,6 +82,8 @@ pub struct AgentRun {
     external: Vector2<f64>,
     /// What the current step has produced so far.
     log: StepLog,
+    /// A force commanded from outside (see [`AgentRun::command`]), N.
+    command: Option<Vector2<f64>>,
 }
 
 /// An agent's body: a disc pushed in any direction, or a robot on wheels steered by its
@@ -303,7 +305,23 @@ impl AgentRun {
                 }),
             external: Vector2::from(world.external_acceleration),
             log: StepLog::default(),
+            command: None,
         }
+    }
+
+    /// Commands the force applied to the body from the next step on, N, instead of its control
+    /// law's (which still runs, so that its own state moves on), until `None` gives control
+    /// back: a policy other than the law drives the body (from Python, say). The clearance
+    /// envelope, when on, still keeps the commanded body from touching a wall, and the speed
+    /// limit does not apply. A force that is not finite is refused (`false`), as is any force
+    /// for a robot on wheels under the unicycle law, which commands its wheels itself.
+    pub fn command(&mut self, force: Option<Vector2<f64>>) -> bool {
+        let unicycle = self.agent.controller.kind == ControllerKind::Unicycle;
+        if force.is_some_and(|f| !f.iter().all(|c| c.is_finite()) || unicycle) {
+            return false;
+        }
+        self.command = force;
+        true
     }
 
     /// Whether it keeps the clearance envelope.
@@ -564,6 +582,14 @@ impl AgentRun {
             }
         }
         let mut force = self.log.control.map_or(Vector2::zeros(), |c| c.force);
+        if let Some(commanded) = self.command.filter(|_| !self.frozen) {
+            // Commanded from outside: the law ran (its state, a bias or a clamp, moves on as
+            // if it were in control) but this force goes to the body instead.
+            force = commanded;
+            if let Some(control) = &mut self.log.control {
+                control.force = commanded;
+            }
+        }
         let c = &self.agent.controller;
         match (&self.body, &self.agent.drive) {
             (AgentBody::Drive(body), Some(drive))
