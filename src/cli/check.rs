@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use super::{Failure, load};
 use crate::field::FreeSpace;
 use crate::sim::Simulation;
-use crate::world::SensorKind;
 use nalgebra::Vector2;
 
 /// A passage on an agent's kinematic path is narrow when it leaves the body's centre less than
@@ -64,11 +63,7 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
                 println!("{}: warning: {warning}", path.display());
             }
             // A lidar agent is not refused (it must find out online), but the user is told.
-            for agent in world
-                .agents
-                .iter()
-                .filter(|a| a.sensor.is_some_and(|s| s.kind == SensorKind::Lidar))
-            {
+            for agent in world.agents.iter().filter(|a| a.has_lidar()) {
                 if let Err(e) = FreeSpace::of(&world, agent) {
                     println!(
                         "{}: note: with full knowledge of the walls, {e}; `{}` plans on what its lidar sees and will find out online",

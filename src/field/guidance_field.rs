@@ -22,9 +22,7 @@ impl GuidanceField {
     /// The field of `agent` in `world` (with the world's field kind), with `others` as
     /// obstacles besides the walls.
     pub fn build(world: &World, agent: &Agent, others: &[Disc]) -> Result<Self, FieldError> {
-        let lidar = agent
-            .sensor
-            .is_some_and(|s| s.kind == crate::world::SensorKind::Lidar);
+        let lidar = agent.has_lidar();
         Ok(match world.field.kind {
             // A lidar agent has seen nothing yet: every cell counts as free.
             FieldKind::Harmonic if lidar => {

@@ -7,7 +7,7 @@ use super::FieldError;
 use super::grid::Grid;
 use super::known::KnownMap;
 use super::laplace;
-use crate::world::{Agent, FieldKind, SensorKind, WallShape, World, all_wall_shapes};
+use crate::world::{Agent, FieldKind, WallShape, World, all_wall_shapes};
 
 /// Another agent's disc, seen as an obstacle.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -197,7 +197,7 @@ impl FreeSpace {
         world
             .agents
             .iter()
-            .filter(|a| !a.sensor.is_some_and(|s| s.kind == SensorKind::Lidar))
+            .filter(|a| !a.has_lidar())
             .filter_map(|agent| Self::of(world, agent).err())
             .collect()
     }

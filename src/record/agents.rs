@@ -137,8 +137,8 @@ impl Steps {
         let mut sent = false;
         let agents = sim.agents.iter().zip(states);
         let logged = (self.fields_logged.iter_mut()).zip(&mut self.replans_logged);
-        for ((run, state), (columns, (field_logged, replan_logged))) in
-            agents.zip(self.columns.iter_mut().zip(logged))
+        for (index, ((run, state), (columns, (field_logged, replan_logged)))) in
+            agents.zip(self.columns.iter_mut().zip(logged)).enumerate()
         {
             log_events(rec, sim.time(), columns.paths(), state)?;
             if run.lidar.is_none() && !sim.obstacles.is_empty() {
@@ -146,7 +146,7 @@ impl Steps {
                 let now = run.metrics.resolves();
                 if now != resolves && sim.time() >= at + REPLAN_IMAGE_EVERY {
                     *replan_logged = (sim.time(), now);
-                    log_replanned(rec, columns.paths(), sim, run)?;
+                    log_replanned(rec, columns.paths(), sim, (index, run))?;
                 }
             }
             if let Some(lidar) = &run.lidar {
@@ -215,21 +215,21 @@ fn replots_field(sim: &Simulation) -> bool {
     !sim.obstacles.is_empty() && sim.world.field.replan == crate::world::Replan::Full
 }
 
-/// The guidance of an agent without a lidar that replans around moving obstacles, as its field
-/// is now (and the field's image, where the whole field is re-solved).
+/// The guidance of agent `index`, `run`, which replans around moving obstacles without a lidar,
+/// as its field is now (and the field's image, where the whole field is re-solved; a thumbnail
+/// but for the first agent's, as at the set-up).
 fn log_replanned(
     rec: &RecordingStream,
     paths: &AgentPaths,
     sim: &Simulation,
-    run: &AgentRun,
+    (index, run): (usize, &AgentRun),
 ) -> Result<(), rerun::RecordingStreamError> {
     rec.set_duration_secs(SIM_TIME, sim.time());
     rec.log(paths.guidance.as_str(), &arrows(sim, run))?;
     if replots_field(sim)
         && let Some(field) = run.field.harmonic()
     {
-        let index = sim.agents.iter().position(|a| std::ptr::eq(a, run));
-        let stride = if index == Some(0) {
+        let stride = if index == 0 {
             1
         } else {
             thumbnail_stride(field.grid())

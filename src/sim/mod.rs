@@ -13,8 +13,9 @@
 //! The agents whose fields are due are re-solved in parallel (rayon), after every agent's state
 //! and sensor reading have been taken in order, so a run does not depend on the threads.
 //! Moving obstacles ([`obstacles`]) are kinematic bodies that Rapier moves along their scripts;
-//! an agent with a lidar sees them in its scans, any other agent as it sees the other agents
-//! (discs that hold them, grown by how far they move before the next replan).
+//! an agent with a lidar sees them in its scans, any other agent as it sees the other agents:
+//! discs that hold them where they are and where their velocities take them within
+//! `field.obstacle_horizon` (ORCA: where they are), grown as the other agents' discs are.
 //! A noisy sensor rebuilds the field from each reading. A rebuild that fails (the others or the
 //! sensed walls cut the agent off) keeps the last field and logs a note once.
 
@@ -123,7 +124,8 @@ impl Simulation {
         let fields: Vec<Result<_, FieldError>> = (0..world.agents.len())
             .into_par_iter()
             .map(|index| {
-                let lidar = has_lidar(&world.agents[index]);
+                // A lidar agent sees the moving obstacles in its map, not as discs.
+                let lidar = world.agents[index].has_lidar();
                 let others = seen_by(&starts, &seen, index, lidar);
                 first_field(
                     world,
@@ -368,13 +370,6 @@ fn sighted(obstacles: &[obstacles::ObstacleRun], horizon: f64) -> Vec<Neighbour>
     (obstacles.iter())
         .flat_map(|o| o.neighbours_ahead(horizon))
         .collect()
-}
-
-/// Whether an agent scans with a lidar (it sees the moving obstacles in its map, not as discs).
-fn has_lidar(agent: &crate::world::Agent) -> bool {
-    agent
-        .sensor
-        .is_some_and(|s| s.kind == crate::world::SensorKind::Lidar)
 }
 
 /// What agent `index` sees as neighbours: the other agents' `bodies`, and the discs `seen` of

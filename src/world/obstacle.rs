@@ -8,7 +8,7 @@
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-use super::schema::{Wall, World, fixed_length};
+use super::schema::{Wall, World, fixed_length, optional_pair};
 use super::shapes::wall_shape;
 use super::validate::check_wall;
 
@@ -172,12 +172,6 @@ impl Obstacle {
 
 fn default_turn() -> f64 {
     1.0
-}
-
-fn optional_pair<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
-    Option::<Vec<f64>>::deserialize(d)?
-        .map(|v| fixed_length(v, None))
-        .transpose()
 }
 
 fn optional_points<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f64; 2]>>, D::Error> {

@@ -538,6 +538,11 @@ impl Agent {
         self.shape.as_ref().is_some_and(|s| *s != AgentShape::Disc)
     }
 
+    /// Whether the agent senses with a lidar (it plans on the map its scans build).
+    pub fn has_lidar(&self) -> bool {
+        self.sensor.is_some_and(|s| s.kind == SensorKind::Lidar)
+    }
+
     /// The radius of the target disc, m: `target_radius`, or the agent's radius by default
     /// (the field trims the default to free space).
     pub fn target_disc(&self) -> f64 {
@@ -633,7 +638,7 @@ pub struct LinkSettings {
 }
 
 /// An optional pair of numbers, checked like [`exactly`].
-fn optional_pair<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+pub(super) fn optional_pair<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
     Option::<Vec<f64>>::deserialize(d)?
         .map(|v| fixed_length(v, None))
         .transpose()
