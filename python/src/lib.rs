@@ -146,7 +146,7 @@ fn run_json(
     let World { world, .. } = load(path, set)?;
     let options = nadf::run::RunOptions {
         recording: record,
-        viewer: viewer(spawn, connect),
+        viewer: Viewer::from_flags(spawn, connect),
         ..Default::default()
     };
     let report = py
@@ -198,15 +198,6 @@ impl Drop for Running {
     }
 }
 
-/// The viewer of the CLI's `--spawn` and `--connect URL`.
-fn viewer(spawn: bool, connect: Option<String>) -> Option<Viewer> {
-    match (connect, spawn) {
-        (Some(url), _) => Some(Viewer::Connect(url)),
-        (None, true) => Some(Viewer::Spawn),
-        (None, false) => None,
-    }
-}
-
 impl Simulation {
     fn with<T>(&self, f: impl FnOnce(&mut Running) -> T) -> T {
         let mut running = self.inner.lock().unwrap_or_else(|e| e.into_inner());
@@ -237,7 +228,7 @@ impl Simulation {
         connect: Option<String>,
     ) -> PyResult<Self> {
         let world = &world.world;
-        let viewer = viewer(spawn, connect);
+        let viewer = Viewer::from_flags(spawn, connect);
         if let Some(path) = &record {
             nadf::output::check_file(path).map_err(|e| RunError::new_err(e.to_string()))?;
         }

@@ -40,11 +40,7 @@ pub struct RunArgs {
 pub fn run(args: &RunArgs, console: &Console) -> Result<(), Failure> {
     let path = &args.world;
     let world = load(path, &args.overrides)?;
-    let viewer = match (&args.connect, args.spawn) {
-        (Some(url), _) => Some(Viewer::Connect(url.clone())),
-        (None, true) => Some(Viewer::Spawn),
-        (None, false) => None,
-    };
+    let viewer = Viewer::from_flags(args.spawn, args.connect.clone());
     // Streaming to a viewer replaces the default file; -o saves one too.
     let recording = match (&args.output, args.no_record, &viewer) {
         (Some(out), _, _) => Some(out.clone()),

@@ -403,7 +403,7 @@ fn footprint(drive: &crate::world::DriveSettings) -> Vec<Vec<[f32; 2]>> {
 
 /// Sends `columns` of `entity`, one row per time of `times` (s on `sim_time`), unless there
 /// are none.
-fn send(
+pub(super) fn send(
     rec: &RecordingStream,
     entity: &str,
     times: &[f64],

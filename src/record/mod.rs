@@ -91,6 +91,23 @@ pub enum Viewer {
     Connect(String),
 }
 
+impl Viewer {
+    /// The viewer of `--spawn` and `--connect URL` (`connect` wins when both are given), if any.
+    ///
+    /// ```
+    /// # use nadf::record::Viewer;
+    /// assert_eq!(Viewer::from_flags(true, None), Some(Viewer::Spawn));
+    /// assert_eq!(Viewer::from_flags(false, None), None);
+    /// ```
+    pub fn from_flags(spawn: bool, connect: Option<String>) -> Option<Self> {
+        match (connect, spawn) {
+            (Some(url), _) => Some(Self::Connect(url)),
+            (None, true) => Some(Self::Spawn),
+            (None, false) => None,
+        }
+    }
+}
+
 /// Where `--connect` streams without a URL: Rerun's default.
 pub const DEFAULT_VIEWER_URL: &str = rerun::DEFAULT_CONNECT_URL;
 

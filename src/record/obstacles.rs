@@ -2,10 +2,10 @@
 //! every step (kept in columns and sent with the agents'), and its path, or a wander's region,
 //! drawn once (static).
 
-use rerun::{RecordingStream, TimeColumn};
+use rerun::RecordingStream;
 
-use super::columns::COLUMN_STEPS;
-use super::names::{ObstaclePaths, SIM_TIME};
+use super::columns::{COLUMN_STEPS, send};
+use super::names::ObstaclePaths;
 use super::palette::{self, size};
 use super::world::f32x2;
 use crate::sim::obstacles::ObstacleRun;
@@ -100,19 +100,16 @@ impl ObstacleSteps {
 
     /// Sends the poses kept so far, one chunk per obstacle, and forgets them.
     pub fn send(&mut self, rec: &RecordingStream) -> Result<(), rerun::RecordingStreamError> {
-        if self.times.is_empty() {
-            return Ok(());
-        }
         let times = std::mem::take(&mut self.times);
         for (paths, poses) in self.paths.iter().zip(&mut self.poses) {
             let (at, angles): (Vec<[f32; 3]>, Vec<f32>) = std::mem::take(poses).into_iter().unzip();
             let turns = angles.into_iter().map(|a| {
                 rerun::RotationAxisAngle::new([0.0, 0.0, 1.0], rerun::Angle::from_radians(a))
             });
-            let column = TimeColumn::new_duration_secs(SIM_TIME, times.iter().copied());
-            rec.send_columns(
-                paths.body.as_str(),
-                [column],
+            send(
+                rec,
+                &paths.body,
+                &times,
                 rerun::Transform3D::update_fields()
                     .with_many_translation(at)
                     .with_many_rotation_axis_angle(turns)
