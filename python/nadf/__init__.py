@@ -88,6 +88,14 @@ class Simulation:
             world, None if record is None else os.fspath(record), spawn, connect
         )
 
+    @classmethod
+    def _of(cls, world: World, sim: "_nadf.Simulation") -> "Simulation":
+        """The simulation ``sim`` of ``world`` built elsewhere (an environment's episode)."""
+        self = cls.__new__(cls)
+        self.world = world
+        self._sim = sim
+        return self
+
     def step(self, n: int = 1) -> float:
         """Advances ``n`` physics steps (the GIL released while they run); returns the time, s."""
         if n < 0:

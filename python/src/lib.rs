@@ -109,6 +109,22 @@ impl World {
             .collect()
     }
 
+    /// The world as JSON: every value as it runs, after the overrides and the defaults (two
+    /// worlds that run alike have the same text).
+    fn to_json(&self) -> String {
+        serde_json::to_string(&self.world).expect("plain data")
+    }
+
+    /// The same world with its seed `seed` (everything random in a run drawn anew).
+    fn reseeded(&self, seed: u64) -> World {
+        let mut world = self.world.clone();
+        world.seed = seed;
+        World {
+            world,
+            path: self.path.clone(),
+        }
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "World({:?}: {} agent(s), {} s at dt = {} s)",
@@ -401,6 +417,107 @@ impl Simulation {
             Ok((arrays, field.grid().origin, field.grid().cell))
         })
     }
+
+    /// What an environment needs to know of agent `agent` once: its target (m), radius (m),
+    /// mass (kg), `max_force` (N, if any), the half-width of its settling band (m, where
+    /// `reached` is judged), and its lidar's rays and range (m), if it has one.
+    #[allow(clippy::type_complexity)]
+    fn agent_info(
+        &self,
+        agent: usize,
+    ) -> PyResult<([f64; 2], f64, f64, Option<f64>, f64, Option<(usize, f64)>)> {
+        self.with(|r| {
+            let run = agent_of(&r.sim, agent)?;
+            let a = &run.agent;
+            let lidar = run.lidar.as_ref().map(|l| {
+                let s = &l.lidar.settings;
+                let rays = s.rays.unwrap_or(nadf::sim::lidar::DEFAULT_RAYS).max(1) as usize;
+                (rays, s.range.unwrap_or(0.0))
+            });
+            let band = run.metrics.band();
+            Ok((
+                a.target,
+                a.radius,
+                a.mass,
+                a.controller.max_force,
+                band,
+                lidar,
+            ))
+        })
+    }
+
+    /// Agent `agent`'s state for an observation, in one call: its position (m), velocity
+    /// (m/s), the angle of its body frame (rad: a robot on wheels' heading, 0 for a disc,
+    /// which has no orientation), the unit direction of steepest descent of its field at its
+    /// position (`None` where the field has none), its lidar's last ranges as little-endian
+    /// `f32` bytes (`None` without a lidar; empty before the first scan), and its contact
+    /// starts so far.
+    #[allow(clippy::type_complexity)]
+    fn observation<'py>(
+        &self,
+        py: Python<'py>,
+        agent: usize,
+    ) -> PyResult<(
+        [f64; 2],
+        [f64; 2],
+        f64,
+        Option<[f64; 2]>,
+        Option<Bound<'py, PyBytes>>,
+        usize,
+    )> {
+        self.with(|r| {
+            let run = agent_of(&r.sim, agent)?;
+            let state = r.states.get(agent);
+            let position = state.map_or(run.agent.start, |s| s.position.into());
+            let velocity = state.map_or(run.agent.initial_velocity, |s| s.velocity.into());
+            let frame = match state {
+                Some(AgentState {
+                    axle: Some((_, heading)),
+                    ..
+                }) => *heading,
+                _ if run.agent.drive.is_some() => run.agent.heading,
+                _ => 0.0,
+            };
+            let guidance = (run.field.gradient(position))
+                .and_then(|g| nadf::control::unit(&-g))
+                .map(Into::into);
+            let ranges = run.lidar.as_ref().map(|l| {
+                let bytes: Vec<u8> = (l.lidar.ranges().iter())
+                    .flat_map(|r| (*r as f32).to_le_bytes())
+                    .collect();
+                PyBytes::new(py, &bytes)
+            });
+            Ok((
+                position,
+                velocity,
+                frame,
+                guidance,
+                ranges,
+                run.metrics.contacts(),
+            ))
+        })
+    }
+
+    /// The force agent `agent`'s law would apply in the next step from the state it is in
+    /// now, N, computed without changing anything (`Simulation::law_force`): the expert's
+    /// action. The field is the current one (a replan or a scan due in the next step is not
+    /// anticipated).
+    fn law_force(&self, agent: usize) -> PyResult<[f64; 2]> {
+        self.with(|r| {
+            agent_of(&r.sim, agent)?;
+            Ok(r.sim.law_force(agent).map_or([0.0; 2], Into::into))
+        })
+    }
+}
+
+/// Agent `agent` of `sim`, or an `IndexError` naming how many there are.
+fn agent_of(sim: &nadf::sim::Simulation, agent: usize) -> PyResult<&AgentRun> {
+    sim.agents.get(agent).ok_or_else(|| {
+        PyIndexError::new_err(format!(
+            "agent {agent}: the world has {} agent(s)",
+            sim.agents.len()
+        ))
+    })
 }
 
 /// The extension module.

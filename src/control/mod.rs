@@ -145,6 +145,67 @@ impl<const N: usize> Controller<N> {
         if let Some(integrator) = &mut self.integrator {
             integrator.observe(input);
         }
+        let (force, clamping, speed_limited) = self.law(input, self.integrator.as_ref());
+        if let Some(integrator) = &mut self.integrator {
+            integrator.applied(input, &force);
+        }
+        let bias_updated = self
+            .bias
+            .as_mut()
+            .is_some_and(|bias| bias.observe(input, &force));
+        ControlOutput {
+            force,
+            clamping,
+            speed_limited,
+            bias_updated,
+        }
+    }
+
+    /// The force [`Controller::step`] would return for `input`, without changing anything:
+    /// the integrator's estimate of the external force and the bias's settling detector stay
+    /// as they are (`bias_updated` is `false`). What a policy learning against the law asks
+    /// for as the expert's action in the current state.
+    ///
+    /// ```
+    /// use nadf::control::{ControlInput, Controller, Nadf};
+    /// use nalgebra::Vector2;
+    ///
+    /// let mut controller = Controller::<2>::new(vec![Box::new(Nadf { b_d: 10.0 })], 1.0);
+    /// let input = ControlInput {
+    ///     offset: Vector2::new(1.0, 0.0),
+    ///     velocity: Vector2::new(0.5, 0.0),
+    ///     gradient: Some(Vector2::new(1.0, 0.0)),
+    ///     curvature: None,
+    ///     dt: 0.01,
+    ///     touching: false,
+    ///     reference_velocity: None,
+    /// };
+    /// let preview = controller.evaluate(&input);
+    /// assert_eq!(preview.force, controller.evaluate(&input).force); // nothing moved on
+    /// assert_eq!(preview.force, controller.step(&input).force);
+    /// ```
+    pub fn evaluate(&self, input: &ControlInput<N>) -> ControlOutput<N> {
+        let integrator = self.integrator.clone().map(|mut integrator| {
+            integrator.observe(input);
+            integrator
+        });
+        let (force, clamping, speed_limited) = self.law(input, integrator.as_ref());
+        ControlOutput {
+            force,
+            clamping,
+            speed_limited,
+            bias_updated: false,
+        }
+    }
+
+    /// The force of the laws, the bias and the clamp for `input`, integrated over the step by
+    /// `integrator` (its external force observed for this step), saturated and speed-limited;
+    /// with whether the clamp acted and whether the speed limit did.
+    fn law(
+        &self,
+        input: &ControlInput<N>,
+        integrator: Option<&Integrator<N>>,
+    ) -> (SVector<f64, N>, bool, bool) {
         let v = &input.velocity;
         let mut split = self
             .laws
@@ -158,7 +219,7 @@ impl<const N: usize> Controller<N> {
         let mut clamping = false;
         if let Some(clamp) = &self.clamp {
             // The clamp's rest band: what the other forces do to the velocity in one step.
-            let rest_speed = self.integrator.as_ref().map_or(0.0, |i| {
+            let rest_speed = integrator.map_or(0.0, |i| {
                 Clamp::rest_speed((split.explicit + i.external()).norm(), input.dt, i.mass)
             });
             clamping = clamp.active(input, rest_speed);
@@ -166,7 +227,7 @@ impl<const N: usize> Controller<N> {
                 split = split.add(Split::spring(clamp.kc, &input.offset), v);
             }
         }
-        let mut total = match &self.integrator {
+        let mut total = match integrator {
             Some(integrator) => integrator.force(&split, input),
             None => split.force(v),
         };
@@ -187,19 +248,7 @@ impl<const N: usize> Controller<N> {
         } else {
             SVector::zeros()
         };
-        if let Some(integrator) = &mut self.integrator {
-            integrator.applied(input, &force);
-        }
-        let bias_updated = self
-            .bias
-            .as_mut()
-            .is_some_and(|bias| bias.observe(input, &force));
-        ControlOutput {
-            force,
-            clamping,
-            speed_limited,
-            bias_updated,
-        }
+        (force, clamping, speed_limited)
     }
 
     /// The current bias β, N, if the controller has one.

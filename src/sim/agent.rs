@@ -429,11 +429,7 @@ impl AgentRun {
             self.log.scan = Some(beams);
         }
         if self.orca.is_some() {
-            let grown = self.orca_growth(world.dt);
-            plan.neighbours = others;
-            for n in &mut plan.neighbours {
-                n.radius += grown;
-            }
+            plan.neighbours = self.grown_for_orca(others, world.dt);
         } else {
             // Each other agent's disc is grown by how far it moves before the next replan, so
             // the field keeps the agent off where the other will be, not only where it is
@@ -827,30 +823,11 @@ impl AgentRun {
         dt: f64,
         neighbours: &[Neighbour],
     ) -> ControlOutput<2> {
-        let x = x + self.position_error;
-        // The neighbours were grown in `plan`.
-        let (orca, radius) = (self.orca, self.agent.radius + self.orca_growth(dt));
-        let reference = |offset: &Vector2<f64>, gradient: Option<Vector2<f64>>| {
-            orca.map(|orca| {
-                let me = Neighbour {
-                    position: x,
-                    velocity: v,
-                    radius,
-                    reciprocal: true,
-                };
-                let preferred = orca.preferred_velocity(gradient, *offset);
-                orca.velocity(&me, preferred, neighbours, dt)
-            })
-        };
-        let sensed = Sensed {
-            velocity: v,
-            dt,
-            touching: !self.touching.is_empty(),
-            curvature: self.gradient_guidance,
-        };
+        let (x, sensed) = self.sensed(x, v, dt);
+        let reference = self.reference(x, v, dt, neighbours);
         let (out, rejected) = control(
             &self.field,
-            &mut self.controller,
+            |input| self.controller.step(input),
             x.into(),
             sensed,
             reference,
@@ -871,6 +848,85 @@ impl AgentRun {
             ));
         }
         out
+    }
+
+    /// What its law sees of a body at `x` moving at `v` for a step of `dt`: the position
+    /// through the sensor's position error, and the rest of the state.
+    fn sensed(&self, x: Vector2<f64>, v: Vector2<f64>, dt: f64) -> (Vector2<f64>, Sensed<2>) {
+        let sensed = Sensed {
+            velocity: v,
+            dt,
+            touching: !self.touching.is_empty(),
+            curvature: self.gradient_guidance,
+        };
+        (x + self.position_error, sensed)
+    }
+
+    /// ORCA's velocity for the agent at `x` (as it sees itself) moving at `v` among its
+    /// `neighbours` (grown in `plan`), from the offset to the target and the gradient; `None`
+    /// for any other controller.
+    fn reference<'a>(
+        &self,
+        x: Vector2<f64>,
+        v: Vector2<f64>,
+        dt: f64,
+        neighbours: &'a [Neighbour],
+    ) -> impl FnOnce(&Vector2<f64>, Option<Vector2<f64>>) -> Option<Vector2<f64>> + use<'a> {
+        let (orca, radius) = (self.orca, self.agent.radius + self.orca_growth(dt));
+        move |offset, gradient| {
+            orca.map(|orca| {
+                let me = Neighbour {
+                    position: x,
+                    velocity: v,
+                    radius,
+                    reciprocal: true,
+                };
+                let preferred = orca.preferred_velocity(gradient, *offset);
+                orca.velocity(&me, preferred, neighbours, dt)
+            })
+        }
+    }
+
+    /// The force its law would apply in a step of `dt` (s) from the state the body is in now,
+    /// N, computed without changing anything (see [`Controller::evaluate`]); an ORCA agent's
+    /// among the `others` (the other agents and the obstacles, as the step loop gives them).
+    /// As in a step: zero for a frozen body, the stopping force for a lidar agent whose map
+    /// closes every route. The field is the current one: a replan or a scan due at the next
+    /// step is not anticipated, so the law's force in that step can differ.
+    pub fn law_force(
+        &self,
+        physics: &PhysicsWorld,
+        dt: f64,
+        others: Vec<Neighbour>,
+    ) -> Vector2<f64> {
+        let Some((x, v)) = self.body.state(physics).filter(|_| !self.frozen) else {
+            return Vector2::zeros();
+        };
+        let x = Vector2::from(x);
+        if self
+            .lidar
+            .as_ref()
+            .is_some_and(|r| r.intractable_at.is_some())
+        {
+            return -v * (self.agent.mass / dt);
+        }
+        let neighbours = self.grown_for_orca(others, dt);
+        let (seen, sensed) = self.sensed(x, v, dt);
+        let reference = self.reference(seen, v, dt, &neighbours);
+        let law = |input: &_| self.controller.evaluate(input);
+        control(&self.field, law, seen.into(), sensed, reference)
+            .0
+            .force
+    }
+
+    /// The `others` as ORCA sees them for steps of `dt` (s): each disc grown by
+    /// [`AgentRun::orca_growth`].
+    fn grown_for_orca(&self, mut others: Vec<Neighbour>, dt: f64) -> Vec<Neighbour> {
+        let grown = self.orca_growth(dt);
+        for n in &mut others {
+            n.radius += grown;
+        }
+        others
     }
 
     /// How much ORCA grows every disc, its own and its neighbours', for steps of `dt` (s), m.

@@ -16,7 +16,7 @@ use nalgebra::{SVector, Vector2, Vector3};
 use rapier2d::prelude::{PhysicsWorld, RigidBodyHandle};
 
 use super::physics::{from_rapier, to_rapier};
-use crate::control::{ControlInput, ControlOutput, Controller};
+use crate::control::{ControlInput, ControlOutput};
 use crate::field::{ConfigurationSpace, Pose, angle_difference};
 
 /// A body in Rapier whose configuration lives in an `N`-dimensional configuration space.
@@ -120,12 +120,15 @@ pub struct Sensed<const N: usize> {
 }
 
 /// One control step of a body at configuration `q` (as its controller sees it) in `space`:
-/// the guidance there, then `controller`'s force. `reference` gives the velocity a tracking law
-/// follows (ORCA's) from the offset and the gradient, if any. The force is zero, and the
-/// second value `true`, when it is finite in f64 but not in Rapier's f32.
+/// the guidance there, then the force `law` gives for it (a controller's
+/// [`Controller::step`](crate::control::Controller::step), or its side-effect-free
+/// [`Controller::evaluate`](crate::control::Controller::evaluate)). `reference` gives
+/// the velocity a tracking law follows (ORCA's) from the offset and the gradient, if any. The
+/// force is zero, and the second value `true`, when it is finite in f64 but not in Rapier's
+/// f32.
 pub fn control<const N: usize, S: ConfigurationSpace<N>>(
     space: &S,
-    controller: &mut Controller<N>,
+    law: impl FnOnce(&ControlInput<N>) -> ControlOutput<N>,
     q: S::Config,
     sensed: Sensed<N>,
     reference: impl FnOnce(&SVector<f64, N>, Option<SVector<f64, N>>) -> Option<SVector<f64, N>>,
@@ -142,7 +145,7 @@ pub fn control<const N: usize, S: ConfigurationSpace<N>>(
         touching: sensed.touching,
         reference_velocity,
     };
-    let mut out = controller.step(&input);
+    let mut out = law(&input);
     // Finite in f64 but beyond f32's range is still not finite for Rapier.
     let rejected = !out.force.iter().all(|c| (*c as f32).is_finite());
     if rejected {

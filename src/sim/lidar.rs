@@ -23,6 +23,8 @@ pub struct Lidar {
     rng: SplitMix,
     /// Scans taken so far.
     pub scans: usize,
+    /// The last scan's range along each ray, m, in the rays' order (empty before the first).
+    ranges: Vec<f64>,
 }
 
 impl Lidar {
@@ -33,7 +35,16 @@ impl Lidar {
             // Another stream than the walls sensor's for the same seed and agent.
             rng: SplitMix::new(seed ^ (index as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03)),
             scans: 0,
+            ranges: Vec::new(),
         }
+    }
+
+    /// The last scan's reading along each of its rays, m, in the order they are cast (ray `k`
+    /// at `heading − fov/2 + (k + ½) fov/rays`, the heading being the direction to the
+    /// target): the distance to the hit, or the range where the ray hit nothing or was lost.
+    /// Empty before the first scan.
+    pub fn ranges(&self) -> &[f64] {
+        &self.ranges
     }
 
     /// Whether a scan is due at simulated time `t`, s.
@@ -58,6 +69,7 @@ impl Lidar {
         let filter = QueryFilter::default().exclude_collider(own);
         let origin = Vector::new(from[0] as f32, from[1] as f32);
         let mut beams = Vec::with_capacity(rays as usize);
+        self.ranges.clear();
         for k in 0..rays {
             let angle = heading - 0.5 * fov + (k as f64 + 0.5) * fov / rays as f64;
             let (sin, cos) = angle.sin_cos();
@@ -68,12 +80,14 @@ impl Lidar {
             // Draw both every time, so that one ray's outcome does not shift the others' noise.
             let (lost, noise) = (self.rng.uniform() < dropout, self.rng.normal());
             if lost {
+                self.ranges.push(range);
                 continue;
             }
             let (distance, hit) = match hit {
                 Some(d) => ((d + self.settings.noise * noise).clamp(0.0, range), true),
                 None => (range, false),
             };
+            self.ranges.push(distance);
             beams.push(Beam {
                 from,
                 to: [from[0] + distance * cos, from[1] + distance * sin],
@@ -132,6 +146,29 @@ mod tests {
         }
         for b in beams.iter().filter(|b| !b.hit) {
             assert!((b.to[0].hypot(b.to[1]) - 5.0).abs() < 1e-9, "{b:?}");
+        }
+    }
+
+    /// The ranges hold every ray in order, a lost one reading as the range: as a policy's
+    /// observation they keep their length whatever the dropout.
+    #[test]
+    fn ranges_have_one_reading_per_ray_in_order() {
+        let (physics, own) = world();
+        let mut scanner = lidar(0.0, 0.0);
+        assert!(scanner.ranges().is_empty());
+        scanner.scan(&physics, [0.0, 0.0], 0.0, own);
+        // Facing +x, the rays go at −135°, −45°, 45° and 135°: the two towards the wall meet
+        // its face 1.9·√2 away, the others see nothing in 5 m.
+        let expected = [5.0, 1.9 * 2f64.sqrt(), 1.9 * 2f64.sqrt(), 5.0];
+        for (r, e) in scanner.ranges().iter().zip(expected) {
+            assert!((r - e).abs() < 1e-4, "{:?}", scanner.ranges());
+        }
+        let mut lossy = lidar(0.0, 0.5);
+        for _ in 0..20 {
+            let beams = lossy.scan(&physics, [0.0, 0.0], 0.0, own);
+            assert_eq!(lossy.ranges().len(), 4);
+            let hits = lossy.ranges().iter().filter(|r| **r < 5.0).count();
+            assert_eq!(hits, beams.iter().filter(|b| b.hit).count());
         }
     }
 

@@ -34,6 +34,7 @@ mod physics;
 mod sensor;
 pub mod shaped;
 
+use nalgebra::Vector2;
 use rapier2d::prelude::PhysicsWorld;
 use rayon::prelude::*;
 
@@ -259,6 +260,28 @@ impl Simulation {
             .collect();
         self.watch_neighbours(&mut states);
         states
+    }
+
+    /// The force agent `agent`'s control law would apply in the next step from the state it is
+    /// in now, N, without changing anything (see [`AgentRun::law_force`]): the expert's
+    /// action for a policy that drives the body instead of its law ([`AgentRun::command`]).
+    /// `None` for an agent the world does not have.
+    pub fn law_force(&self, agent: usize) -> Option<Vector2<f64>> {
+        let run = self.agents.get(agent)?;
+        // Only ORCA's law reads the neighbours (the others see them in their field).
+        let others = if run.orca.is_some() {
+            let bodies: Vec<Neighbour> =
+                self.agents.iter().map(|a| a.body(&self.physics)).collect();
+            seen_by(
+                &bodies,
+                &sighted(&self.obstacles, 0.0),
+                agent,
+                run.lidar.is_some(),
+            )
+        } else {
+            Vec::new()
+        };
+        Some(run.law_force(&self.physics, self.world.dt, others))
     }
 
     /// Records each agent's gap to the nearest other agent, and marks the agents that make no

@@ -228,7 +228,13 @@ impl ShapedRun {
             touching: !self.touching.is_empty(),
             curvature: self.gradient_guidance,
         };
-        let (out, rejected) = control(&self.field, &mut self.controller, pose, sensed, |_, _| None);
+        let (out, rejected) = control(
+            &self.field,
+            |input| self.controller.step(input),
+            pose,
+            sensed,
+            |_, _| None,
+        );
         if rejected {
             self.faults.rejected_forces += 1;
         }
