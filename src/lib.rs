@@ -26,6 +26,7 @@ mod chart;
 pub mod cli;
 pub mod control;
 pub mod expect;
+pub mod experiment;
 pub mod field;
 pub mod metrics;
 pub mod output;

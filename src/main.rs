@@ -4,7 +4,10 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use nadf::cli::{self, CheckArgs, Console, FieldArgs, ReproduceArgs, RunArgs, ScenArgs, SweepArgs};
+use nadf::cli::{
+    self, CheckArgs, Console, ExperimentArgs, FieldArgs, MergeArgs, ReproduceArgs, RunArgs,
+    ScenArgs, SweepArgs,
+};
 
 #[derive(Parser)]
 #[command(
@@ -31,6 +34,12 @@ enum Command {
     /// write `scen.csv` (every run's metrics, skipped scenarios with the reason) and `scen.png`
     /// (success and path / optimal against the optimal length).
     Scen(ScenArgs),
+    /// Run a world many times with sampled values (`[experiment]`: runs, seed, samplers by
+    /// dotted key), each run seeded by its index; all of it or one `--shard I/N`, resumably;
+    /// write `runs.arrow` (one row per run and agent), `summary.csv` and `summary.png`.
+    Experiment(ExperimentArgs),
+    /// Combine the complete shards of an experiment into the results an unsharded run writes.
+    Merge(MergeArgs),
     /// Validate world files and print every problem found (file, line, key).
     Check(CheckArgs),
     /// Run the paper's experiments in parallel and write `report.md` (per claim: the paper's
@@ -47,6 +56,8 @@ fn main() -> ExitCode {
         Command::Field(args) => cli::field(args),
         Command::Sweep(args) => cli::sweep(args, &console),
         Command::Scen(args) => cli::scen(args, &console),
+        Command::Experiment(args) => cli::experiment(args, &console),
+        Command::Merge(args) => cli::merge(args),
         Command::Check(args) => cli::check(args),
         Command::Reproduce(args) => cli::reproduce(args, &console),
     };

@@ -75,3 +75,14 @@ def run_json(
     spawn: bool = False,
     connect: Optional[str] = None,
 ) -> str: ...
+def experiment_shard(
+    path: str,
+    out: str,
+    index: int = 0,
+    count: int = 1,
+    resume: bool = False,
+    threads: Optional[int] = None,
+    set: Optional[List[str]] = None,
+) -> Tuple[str, int, int]: ...
+def experiment_info(path: str, set: Optional[List[str]] = None) -> Tuple[str, str, int]: ...
+def merge(dirs: List[str], out: str) -> str: ...

@@ -520,11 +520,66 @@ fn agent_of(sim: &nadf::sim::Simulation, agent: usize) -> PyResult<&AgentRun> {
     })
 }
 
+/// Runs shard `index` of `count` of the experiment file at `path` (with the overrides `set`)
+/// into its directory under `out` on `threads` threads (all cores when `None`), as `nadf
+/// experiment --shard` does, keeping the runs already done with `resume`; the GIL released.
+/// Returns the shard's directory and the runs done now and before.
+#[pyfunction]
+#[pyo3(signature = (path, out, index = 0, count = 1, resume = false, threads = None, set = None))]
+#[allow(clippy::too_many_arguments)]
+fn experiment_shard(
+    py: Python<'_>,
+    path: PathBuf,
+    out: PathBuf,
+    index: u64,
+    count: u64,
+    resume: bool,
+    threads: Option<usize>,
+    set: Option<Vec<String>>,
+) -> PyResult<(PathBuf, usize, usize)> {
+    let sets = overrides(set)?;
+    let shard: nadf::experiment::Shard = format!("{index}/{count}")
+        .parse()
+        .map_err(|e: String| PyValueError::new_err(e))?;
+    let exp = nadf::experiment::Experiment::load(&path, &sets)
+        .map_err(|e| WorldError::new_err(e.to_string()))?;
+    let done = py
+        .detach(|| exp.run_shard(shard, &out, (resume, threads), &|_, _| {}, None))
+        .map_err(RunError::new_err)?;
+    if !done.complete {
+        return Err(RunError::new_err(format!("shard {shard} did not complete")));
+    }
+    Ok((shard.dir(&out), done.ran, done.resumed))
+}
+
+/// The experiment file at `path` (with the overrides `set`) loaded and checked: its name, its
+/// digest (what its shards' manifests must carry) and its runs.
+#[pyfunction]
+#[pyo3(signature = (path, set = None))]
+fn experiment_info(path: PathBuf, set: Option<Vec<String>>) -> PyResult<(String, String, u64)> {
+    let sets = overrides(set)?;
+    let exp = nadf::experiment::Experiment::load(&path, &sets)
+        .map_err(|e| WorldError::new_err(e.to_string()))?;
+    Ok((exp.name, exp.digest, exp.runs))
+}
+
+/// Merges the complete shards in `dirs` into `out`, as `nadf merge` does; returns the
+/// summary's table as text. The GIL released.
+#[pyfunction]
+fn merge(py: Python<'_>, dirs: Vec<PathBuf>, out: PathBuf) -> PyResult<String> {
+    py.detach(|| nadf::experiment::batch::merge(&dirs, &out))
+        .map(|merged| nadf::experiment::results::groups_table(&merged.groups))
+        .map_err(RunError::new_err)
+}
+
 /// The extension module.
 #[pymodule]
 fn _nadf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(run_json, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment_shard, m)?)?;
+    m.add_function(wrap_pyfunction!(merge, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment_info, m)?)?;
     m.add_class::<World>()?;
     m.add_class::<Simulation>()?;
     m.add("WorldError", m.py().get_type::<WorldError>())?;

@@ -11,6 +11,7 @@
 //! | 130 | interrupted with Ctrl-C |
 
 mod check;
+mod experiment;
 mod field;
 mod reproduce;
 mod run;
@@ -18,6 +19,7 @@ mod scen;
 mod sweep;
 
 pub use check::{CheckArgs, check};
+pub use experiment::{ExperimentArgs, MergeArgs, experiment, merge};
 pub use field::{FieldArgs, field};
 pub use reproduce::{ReproduceArgs, reproduce};
 pub use run::{RunArgs, run};

@@ -16,7 +16,7 @@ mod validate;
 
 pub use arm::{Chain, Link};
 pub use body::BodyShape;
-pub use error::{WorldError, WorldErrors};
+pub use error::{WorldError, WorldErrors, line_column};
 pub use load::{Override, WorldFile, load, load_str};
 pub use obstacle::{Obstacle, ObstacleMode, ObstacleShape};
 pub use schema::{
