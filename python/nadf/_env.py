@@ -80,6 +80,36 @@ def measured_force_limit(world: World, agents: Sequence[int]) -> Dict[int, float
     return {i: _LIMITS[key(i)] for i in agents}
 
 
+class Episodes:
+    """The worlds of an environment's episodes. ``begin(seed=s)`` runs the world with its
+    seed ``s`` and seeds a generator from it; ``begin()`` after that draws the next episode's
+    seed from the generator, and before any seed runs the world's own seed."""
+
+    def __init__(self, world: World):
+        self.world = world
+        #: The current episode's world and seed.
+        self.current = world
+        self.seed = world.seed
+        self._rng: Optional[np.random.Generator] = None
+        self._fresh = True
+
+    def begin(self, seed: Optional[int]) -> Optional[World]:
+        """The world of the next episode, or ``None`` when it is the world the environment
+        was built with and its first simulation has not been stepped (it serves again)."""
+        if seed is not None:
+            self._rng = np.random.default_rng(seed)
+            self.seed = int(seed)
+        elif self._rng is not None:
+            self.seed = int(self._rng.integers(0, 2**63))
+        else:
+            self.seed = self.world.seed
+        fresh, self._fresh = self._fresh, False
+        if fresh and self.seed == self.world.seed:
+            return None
+        self.current = self.world.reseeded(self.seed)
+        return self.current
+
+
 def rotation(theta: float) -> np.ndarray:
     """The rotation by ``theta`` (rad): body-frame vectors to the world frame."""
     c, s = math.cos(theta), math.sin(theta)

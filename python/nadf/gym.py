@@ -24,7 +24,7 @@ others keeping their own controllers. Importing this module registers it as
   at most ``arrival_speed`` fast), ``truncated`` at the world's duration.
 - ``reset(seed=s)`` runs the world with its seed ``s`` (everything random: sensor noise, lidar
   dropout, wandering obstacles); ``reset()`` after a seeded reset draws the next episode's seed
-  from the environment's generator, and before any seed runs the world's own.
+  from a generator seeded by ``s``, and before any seed runs the world's own.
 - ``env.unwrapped.expert_action()``: the action of the agent's own law (NADF in the paper's
   worlds) in the current state, the baseline a learned policy must beat.
 """
@@ -37,7 +37,14 @@ import gymnasium
 import numpy as np
 
 from . import _nadf
-from ._env import Controlled, PathLike, agent_index, load_world, measured_force_limit
+from ._env import (
+    Controlled,
+    Episodes,
+    PathLike,
+    agent_index,
+    load_world,
+    measured_force_limit,
+)
 from . import Simulation
 from ._nadf import World
 
@@ -84,26 +91,15 @@ class NavigationEnv(gymnasium.Env):
         )
         self.observation_space = self.agent.observation_space
         self.action_space = self.agent.action_space
-        self._fresh = True
-        self._seeded = False
-        self.episode_seed = self.world.seed
-        self._episode_world = self.world
+        self._episodes = Episodes(self.world)
 
     def reset(
         self, *, seed: Optional[int] = None, options: Optional[dict] = None
     ) -> Tuple[Dict[str, np.ndarray], Dict[str, Any]]:
         super().reset(seed=seed)
-        if seed is not None:
-            self._seeded = True
-            self.episode_seed = int(seed)
-        elif self._seeded:
-            self.episode_seed = int(self.np_random.integers(0, 2**63))
-        else:
-            self.episode_seed = self.world.seed
-        if not self._fresh or self.episode_seed != self.world.seed:
-            self._episode_world = self.world.reseeded(self.episode_seed)
-            self.agent.bind(_nadf.Simulation(self._episode_world))
-        self._fresh = False
+        world = self._episodes.begin(seed)
+        if world is not None:
+            self.agent.bind(_nadf.Simulation(world))
         obs = self.agent.observe()
         return obs, self.agent.info(0.0)
 
@@ -127,7 +123,12 @@ class NavigationEnv(gymnasium.Env):
     @property
     def simulation(self) -> Simulation:
         """The current episode's simulation (positions, fields, summaries so far)."""
-        return Simulation._of(self._episode_world, self.agent.sim)
+        return Simulation._of(self._episodes.current, self.agent.sim)
+
+    @property
+    def episode_seed(self) -> int:
+        """The seed of the current episode's world."""
+        return self._episodes.seed
 
 
 gymnasium.register(ENV_ID, entry_point=NavigationEnv, disable_env_checker=False)

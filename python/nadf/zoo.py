@@ -23,7 +23,14 @@ import numpy as np
 from pettingzoo import ParallelEnv
 
 from . import _nadf
-from ._env import Controlled, PathLike, agent_index, load_world, measured_force_limit
+from ._env import (
+    Controlled,
+    Episodes,
+    PathLike,
+    agent_index,
+    load_world,
+    measured_force_limit,
+)
 from . import Simulation
 from ._nadf import World
 
@@ -73,11 +80,7 @@ class CrowdEnv(ParallelEnv):
         self.possible_agents: List[str] = list(self._controlled)
         self.agents: List[str] = list(self.possible_agents)
         self._sim = sim
-        self._fresh = True
-        self._seeded = False
-        self._rng = np.random.default_rng()
-        self.episode_seed = self.world.seed
-        self._world_now = self.world
+        self._episodes = Episodes(self.world)
 
     @functools.lru_cache(maxsize=None)
     def observation_space(self, agent: str) -> gymnasium.spaces.Space:
@@ -90,18 +93,9 @@ class CrowdEnv(ParallelEnv):
     def reset(
         self, seed: Optional[int] = None, options: Optional[dict] = None
     ) -> Tuple[Dict[str, Dict[str, np.ndarray]], Dict[str, Dict[str, Any]]]:
-        if seed is not None:
-            self._seeded = True
-            self._rng = np.random.default_rng(seed)
-            self.episode_seed = int(seed)
-        elif self._seeded:
-            self.episode_seed = int(self._rng.integers(0, 2**63))
-        else:
-            self.episode_seed = self.world.seed
-        if not self._fresh or self.episode_seed != self.world.seed:
-            self._world_now = self.world.reseeded(self.episode_seed)
-            self._sim = _nadf.Simulation(self._world_now)
-        self._fresh = False
+        world = self._episodes.begin(seed)
+        if world is not None:
+            self._sim = _nadf.Simulation(world)
         self.agents = list(self.possible_agents)
         for a in self._controlled.values():
             a.bind(self._sim)
@@ -146,7 +140,12 @@ class CrowdEnv(ParallelEnv):
     @property
     def simulation(self) -> Simulation:
         """The current episode's simulation (positions, fields, summaries so far)."""
-        return Simulation._of(self._world_now, self._sim)
+        return Simulation._of(self._episodes.current, self._sim)
+
+    @property
+    def episode_seed(self) -> int:
+        """The seed of the current episode's world."""
+        return self._episodes.seed
 
 
 def parallel_env(world: Union[World, PathLike], **kwargs: Any) -> CrowdEnv:
