@@ -278,25 +278,30 @@ fn a_bad_experiment_is_located() {
     }
 }
 
-/// Every shipped experiment loads, and its first run makes a world that runs.
+/// Every shipped experiment loads; the small ones' first run makes a world that runs (the
+/// rooms map's field alone takes seconds).
 #[test]
 fn the_shipped_experiments_load() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
     let mut count = 0;
     for entry in fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "toml") {
-            let exp = Experiment::load(&path, &["duration=0.5".parse().unwrap()])
-                .unwrap_or_else(|e| panic!("{e}"));
-            let record = exp.run(0);
-            assert!(
-                record.outcome.is_ok(),
-                "{}: {:?}",
-                path.display(),
-                record.outcome
-            );
-            count += 1;
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
         }
+        let exp = Experiment::load(&path, &["duration=0.5".parse().unwrap()])
+            .unwrap_or_else(|e| panic!("{e}"));
+        count += 1;
+        if path.to_string_lossy().contains("rooms") {
+            continue;
+        }
+        let record = exp.run(0);
+        assert!(
+            record.outcome.is_ok(),
+            "{}: {:?}",
+            path.display(),
+            record.outcome
+        );
     }
-    assert!(count >= 1);
+    assert!(count >= 3);
 }

@@ -163,7 +163,12 @@ pub fn write_results(
         .collect();
     let arrow = results::arrow_file(records, &columns, (&manifest.experiment, &manifest.digest))?;
     let groups = results::groups(records, &columns, &group);
-    let title = format!("{}: {} runs", manifest.experiment, manifest.runs);
+    let by = if manifest.group.is_empty() {
+        String::new()
+    } else {
+        format!(", by {}", manifest.group.join(", "))
+    };
+    let title = format!("{}: {} runs{by}", manifest.experiment, manifest.runs);
     let picture =
         plot::plot(&groups, &title).map_err(|e| format!("cannot draw the summary: {e}"))?;
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;

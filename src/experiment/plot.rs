@@ -1,4 +1,5 @@
-//! The picture of an experiment's summary: per group, the success rate with its 95 % Wilson
+//! The picture of an experiment's summary: per group (its values on the axis; the grouping
+//! keys are in the title), the success rate with its 95 % Wilson
 //! interval, and the settling time's median with its 90th percentile.
 
 use plotters::prelude::*;
@@ -14,7 +15,7 @@ pub fn plot(groups: &[Group], title: &str) -> Result<Vec<u8>, String> {
     register_font();
     let n = groups.len().max(1) as f64;
     let x = |i: usize| i as f64 + 0.5;
-    let labels: Vec<String> = groups.iter().map(|g| g.label.clone()).collect();
+    let labels: Vec<String> = groups.iter().map(|g| g.values.clone()).collect();
     let label_of = |v: &f64| {
         let i = v.floor();
         (i >= 0.0 && (v - i - 0.5).abs() < 1e-6)

@@ -177,6 +177,8 @@ pub fn arrow_file(
 pub struct Group {
     /// The group's values of the grouping keys (`key=value, ...`; `all` without grouping).
     pub label: String,
+    /// The same values without their keys (`all` without grouping), for a plot's axis.
+    pub values: String,
     /// Runs in it.
     pub runs: usize,
     /// Runs that could not be done (their agents count as not reached).
@@ -259,28 +261,30 @@ pub fn groups(records: &[Record], columns: &[(String, Column)], group: &[usize])
         at("path_length"),
         at("kinematic_length"),
     );
-    let mut by: BTreeMap<String, Vec<&Record>> = BTreeMap::new();
+    let mut by: BTreeMap<(String, String), Vec<&Record>> = BTreeMap::new();
     for r in records {
-        let label = if group.is_empty() {
-            "all".to_string()
+        let values: Vec<(String, String)> = (group.iter())
+            .map(|&i| {
+                let v = r.values[i].as_ref().map_or("-".into(), |v| match v {
+                    Sampled::Text(s) | Sampled::Other(s) => s.clone(),
+                    other => other.toml(),
+                });
+                (format!("{}={v}", columns[i].0), v)
+            })
+            .collect();
+        let key = if values.is_empty() {
+            ("all".to_string(), "all".to_string())
         } else {
-            (group.iter())
-                .map(|&i| {
-                    let v = r.values[i].as_ref().map_or("-".into(), |v| match v {
-                        Sampled::Text(s) | Sampled::Other(s) => s.clone(),
-                        other => other.toml(),
-                    });
-                    format!("{}={v}", columns[i].0)
-                })
-                .collect::<Vec<_>>()
-                .join(", ")
+            let (labelled, bare): (Vec<_>, Vec<_>) = values.into_iter().unzip();
+            (labelled.join(", "), bare.join(" · "))
         };
-        by.entry(label).or_default().push(r);
+        by.entry(key).or_default().push(r);
     }
     by.into_iter()
-        .map(|(label, records)| {
+        .map(|((label, values), records)| {
             let mut g = Group {
                 label,
+                values,
                 runs: records.len(),
                 failed: 0,
                 agents: 0,
@@ -357,10 +361,14 @@ pub fn groups_csv(groups: &[Group]) -> String {
     out
 }
 
-/// The groups as a table to print.
+/// The groups as a table to print (the group column as wide as its longest label).
 pub fn groups_table(groups: &[Group]) -> String {
+    let width = groups
+        .iter()
+        .map(|g| g.label.chars().count())
+        .fold(5, usize::max);
     let mut out = format!(
-        "{:<32} {:>6} {:>7} {:>18} {:>9} {:>15} {:>13}\n",
+        "{:<width$} {:>6} {:>7} {:>20} {:>9} {:>17} {:>12}\n",
         "group", "runs", "reached", "success (95 %)", "contacts", "settle p50/p90", "path/opt p50"
     );
     for g in groups {
@@ -368,17 +376,15 @@ pub fn groups_table(groups: &[Group]) -> String {
             .settling
             .map_or("-".into(), |(a, b)| format!("{a:.2}/{b:.2} s"));
         let ratio = g.path_ratio.map_or("-".into(), |(a, _)| format!("{a:.3}"));
-        out.push_str(&format!(
-            "{:<32} {:>6} {:>7} {:>5.1} % [{:>4.1}, {:>5.1}] {:>9.3} {:>15} {:>13}\n",
-            g.label,
-            g.runs,
-            g.reached,
+        let success = format!(
+            "{:.1} % [{:.1}, {:.1}]",
             100.0 * g.success(),
             100.0 * g.interval.0,
-            100.0 * g.interval.1,
-            g.contacts_per_run,
-            settle,
-            ratio
+            100.0 * g.interval.1
+        );
+        out.push_str(&format!(
+            "{:<width$} {:>6} {:>7} {:>20} {:>9.3} {:>17} {:>12}\n",
+            g.label, g.runs, g.reached, success, g.contacts_per_run, settle, ratio
         ));
     }
     out
