@@ -2,6 +2,7 @@
 //! keys are in the title), the success rate with its 95 % Wilson
 //! interval, and the settling time's median with its 90th percentile.
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::results::Group;
@@ -33,22 +34,13 @@ pub fn plot(groups: &[Group], title: &str) -> Result<Vec<u8>, String> {
             .map_err(|e| e.to_string())?;
         let panels = root.split_evenly((2, 1));
 
-        let mut chart = ChartBuilder::on(&panels[0])
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..n, 0.0..105.0)
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(groups.len() * 2 + 1)
-            .x_label_formatter(&label_of)
-            .y_desc("reached (%), 95 % interval")
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 16))
-            .draw()
-            .map_err(|e| e.to_string())?;
+        let mut chart = panel(
+            &panels[0],
+            n,
+            105.0,
+            "reached (%), 95 % interval",
+            &label_of,
+        )?;
         let colour = PALETTE[0];
         for (i, g) in groups.iter().enumerate() {
             let (lo, hi) = (100.0 * g.interval.0, 100.0 * g.interval.1);
@@ -70,22 +62,13 @@ pub fn plot(groups: &[Group], title: &str) -> Result<Vec<u8>, String> {
             .filter_map(|g| g.settling.map(|s| s.1))
             .fold(1.0, f64::max)
             * 1.1;
-        let mut chart = ChartBuilder::on(&panels[1])
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..n, 0.0..top)
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(groups.len() * 2 + 1)
-            .x_label_formatter(&label_of)
-            .y_desc("settling time (s): median, 90th percentile")
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 16))
-            .draw()
-            .map_err(|e| e.to_string())?;
+        let mut chart = panel(
+            &panels[1],
+            n,
+            top,
+            "settling time (s): median, 90th percentile",
+            &label_of,
+        )?;
         for (i, g) in groups.iter().enumerate() {
             if let Some((p50, p90)) = g.settling {
                 chart
@@ -106,4 +89,33 @@ pub fn plot(groups: &[Group], title: &str) -> Result<Vec<u8>, String> {
         root.present().map_err(|e| e.to_string())?;
     }
     Ok(crate::field::export::png(&rgb, w, h))
+}
+
+/// A panel of `n` groups along x (labelled by `label_of` at their centres) and `0..top` up,
+/// with its mesh drawn and its y axis described by `y_desc`.
+fn panel<'a, 'b>(
+    area: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    n: f64,
+    top: f64,
+    y_desc: &str,
+    label_of: &dyn Fn(&f64) -> String,
+) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
+{
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..n, 0.0..top)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(2 * n as usize + 1)
+        .x_label_formatter(label_of)
+        .y_desc(y_desc)
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    Ok(chart)
 }
