@@ -343,12 +343,12 @@ impl Simulation {
 
     /// Each agent's position, m (its start before the first step).
     fn positions(&self) -> Vec<[f64; 2]> {
-        self.per_agent(|a, s| s.map_or(a.agent.start, |s| s.position.into()))
+        self.per_agent(|a, s| motion(a, s).0)
     }
 
     /// Each agent's velocity, m/s.
     fn velocities(&self) -> Vec<[f64; 2]> {
-        self.per_agent(|a, s| s.map_or(a.agent.initial_velocity, |s| s.velocity.into()))
+        self.per_agent(|a, s| motion(a, s).1)
     }
 
     /// The control force each agent applied in the last step, N (zero before the first).
@@ -468,8 +468,7 @@ impl Simulation {
         self.with(|r| {
             let run = agent_of(&r.sim, agent)?;
             let state = r.states.get(agent);
-            let position = state.map_or(run.agent.start, |s| s.position.into());
-            let velocity = state.map_or(run.agent.initial_velocity, |s| s.velocity.into());
+            let (position, velocity) = motion(run, state);
             let frame = match state {
                 Some(AgentState {
                     axle: Some((_, heading)),
@@ -508,6 +507,14 @@ impl Simulation {
             Ok(r.sim.law_force(agent).map_or([0.0; 2], Into::into))
         })
     }
+}
+
+/// An agent's position (m) and velocity (m/s) after the last step `state`; its start and
+/// initial velocity before the first.
+fn motion(run: &AgentRun, state: Option<&AgentState>) -> ([f64; 2], [f64; 2]) {
+    state.map_or((run.agent.start, run.agent.initial_velocity), |s| {
+        (s.position.into(), s.velocity.into())
+    })
 }
 
 /// Agent `agent` of `sim`, or an `IndexError` naming how many there are.

@@ -327,19 +327,7 @@ impl AgentColumns {
         )?;
         let footprint = std::mem::take(&mut self.footprint);
         if footprint.len() == times.len() {
-            let (at, angles): (Vec<[f32; 3]>, Vec<f32>) = footprint.into_iter().unzip();
-            let turns = angles.into_iter().map(|a| {
-                rerun::RotationAxisAngle::new([0.0, 0.0, 1.0], rerun::Angle::from_radians(a))
-            });
-            send(
-                rec,
-                &self.paths.footprint,
-                &times,
-                rerun::Transform3D::update_fields()
-                    .with_many_translation(at)
-                    .with_many_rotation_axis_angle(turns)
-                    .columns_of_unit_batches()?,
-            )?;
+            send_poses(rec, &self.paths.footprint, &times, footprint)?;
         }
         for (path, vectors) in [
             (&self.paths.velocity, std::mem::take(&mut self.velocities)),
@@ -403,6 +391,28 @@ fn footprint(drive: &crate::world::DriveSettings) -> Vec<Vec<[f32; 2]>> {
 
 /// Sends `columns` of `entity`, one row per time of `times` (s on `sim_time`), unless there
 /// are none.
+/// Sends planar `poses` (a translation and a turn about z, rad), one per time of `times`, to
+/// `entity` as the columns of its transform.
+pub(super) fn send_poses(
+    rec: &RecordingStream,
+    entity: &str,
+    times: &[f64],
+    poses: Vec<([f32; 3], f32)>,
+) -> Result<(), rerun::RecordingStreamError> {
+    let (at, angles): (Vec<[f32; 3]>, Vec<f32>) = poses.into_iter().unzip();
+    let turns = (angles.into_iter())
+        .map(|a| rerun::RotationAxisAngle::new([0.0, 0.0, 1.0], rerun::Angle::from_radians(a)));
+    send(
+        rec,
+        entity,
+        times,
+        rerun::Transform3D::update_fields()
+            .with_many_translation(at)
+            .with_many_rotation_axis_angle(turns)
+            .columns_of_unit_batches()?,
+    )
+}
+
 pub(super) fn send(
     rec: &RecordingStream,
     entity: &str,

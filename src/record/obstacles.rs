@@ -4,7 +4,7 @@
 
 use rerun::RecordingStream;
 
-use super::columns::{COLUMN_STEPS, send};
+use super::columns::{COLUMN_STEPS, send_poses};
 use super::names::ObstaclePaths;
 use super::palette::{self, size};
 use super::world::f32x2;
@@ -102,19 +102,7 @@ impl ObstacleSteps {
     pub fn send(&mut self, rec: &RecordingStream) -> Result<(), rerun::RecordingStreamError> {
         let times = std::mem::take(&mut self.times);
         for (paths, poses) in self.paths.iter().zip(&mut self.poses) {
-            let (at, angles): (Vec<[f32; 3]>, Vec<f32>) = std::mem::take(poses).into_iter().unzip();
-            let turns = angles.into_iter().map(|a| {
-                rerun::RotationAxisAngle::new([0.0, 0.0, 1.0], rerun::Angle::from_radians(a))
-            });
-            send(
-                rec,
-                &paths.body,
-                &times,
-                rerun::Transform3D::update_fields()
-                    .with_many_translation(at)
-                    .with_many_rotation_axis_angle(turns)
-                    .columns_of_unit_batches()?,
-            )?;
+            send_poses(rec, &paths.body, &times, std::mem::take(poses))?;
         }
         Ok(())
     }
