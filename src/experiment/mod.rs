@@ -209,13 +209,12 @@ impl Experiment {
         let world = WorldFile::read(&world_path)?;
         // The world and the fixed overrides must make a world before any run is planned.
         world.load(&fixed)?;
-        let world_text = std::fs::read_to_string(&world_path).unwrap_or_default();
         let overrides_text: Vec<String> = fixed.iter().map(ToString::to_string).collect();
         let digest = format!(
             "{:016x}",
             fnv1a(&[
                 text.as_bytes(),
-                world_text.as_bytes(),
+                world.text().as_bytes(),
                 overrides_text.join("\n").as_bytes()
             ])
         );

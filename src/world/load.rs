@@ -92,6 +92,11 @@ impl WorldFile {
         &self.path
     }
 
+    /// The file's text, as read.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
     /// Applies `overrides`, parses and validates. The world's `name` defaults to the file
     /// stem. Every problem found is returned, not only the first.
     pub fn load(&self, overrides: &[Override]) -> Result<World, WorldErrors> {
