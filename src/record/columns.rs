@@ -389,8 +389,6 @@ fn footprint(drive: &crate::world::DriveSettings) -> Vec<Vec<[f32; 2]>> {
     ]
 }
 
-/// Sends `columns` of `entity`, one row per time of `times` (s on `sim_time`), unless there
-/// are none.
 /// Sends planar `poses` (a translation and a turn about z, rad), one per time of `times`, to
 /// `entity` as the columns of its transform.
 pub(super) fn send_poses(
@@ -413,6 +411,8 @@ pub(super) fn send_poses(
     )
 }
 
+/// Sends `columns` of `entity`, one row per time of `times` (s on `sim_time`), unless there
+/// are none.
 pub(super) fn send(
     rec: &RecordingStream,
     entity: &str,
