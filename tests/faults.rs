@@ -107,6 +107,7 @@ fn the_monitor_counts_each_penetration_once_and_each_exit_from_the_box() {
         position: nalgebra::Vector2::new(x, y),
         signed_clearance,
         bounds: world.bounds(),
+        giving_way: false,
     };
     assert!(monitor.observe(&at(1.0, 1.0, 0.5)).is_empty());
     let events = monitor.observe(&at(3.2, 2.0, -0.05));

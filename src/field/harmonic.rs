@@ -100,7 +100,8 @@ impl HarmonicField {
         Self::solve_space(world, agent, space, warm.as_deref(), started)
     }
 
-    fn solve_space(
+    /// Solves the field of `space` for `agent` (warm-started from `warm`, timed from `started`).
+    pub(super) fn solve_space(
         world: &World,
         agent: &Agent,
         space: FreeSpace,

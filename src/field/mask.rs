@@ -20,8 +20,8 @@ pub struct Disc {
 
 impl Disc {
     /// The disc grown by `by` metres, but no further than stays clear of `agent` at `position`
-    /// on a grid of `cell` metres: a disc that comes that near is left out of the agent's
-    /// field (see [`FreeSpace::among`]), and growing must not make it vanish.
+    /// on a grid of `cell` metres: a disc that comes nearer is shrunk in the agent's field
+    /// (see [`obstacle_discs`]), and growing must not make it vanish.
     pub fn grown(self, by: f64, (agent, position): (&Agent, [f64; 2]), cell: f64) -> Self {
         let distance = (position[0] - self.center[0]).hypot(position[1] - self.center[1]);
         let room = distance - self.radius - clear_of(agent, cell);
@@ -69,9 +69,10 @@ impl FreeSpace {
     /// Like [`FreeSpace::of`] with the agent at `position` instead of its start, walls sensed
     /// with errors (wall `k` of [`all_wall_shapes`] moved out by `offsets[k]` m, see
     /// `rasterize`), and the discs `others` (the other agents) as obstacles too.
-    /// A disc that covers the agent's target or the agent itself is left out: an agent parked
-    /// on another's target must not make that target unreachable for good, and two agents in
-    /// contact must still each have a field (the contact is counted by the simulation).
+    /// A disc that covers the agent's target is left out, and one at the agent's skin is
+    /// shrunk to stay clear of its cell ([`obstacle_discs`]): an agent parked on another's
+    /// target must not make that target unreachable for good, and two agents in contact must
+    /// still each have a field (the contact is counted by the simulation).
     pub fn among(
         world: &World,
         agent: &Agent,
@@ -79,11 +80,25 @@ impl FreeSpace {
         offsets: &[f64],
         others: &[Disc],
     ) -> Result<Self, FieldError> {
+        let (grid, blocked) = Self::mask_among(world, agent, position, offsets, others);
+        Self::from_mask(grid, blocked, agent, position)
+    }
+
+    /// The grid and mask of [`FreeSpace::among`], before anything is checked to connect: the
+    /// walls sensed with `offsets` and the discs `others` that are obstacles for `agent` at
+    /// `position` (see [`obstacle_discs`]).
+    pub fn mask_among(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        offsets: &[f64],
+        others: &[Disc],
+    ) -> (Grid, Vec<bool>) {
         let grid = Grid::anchored_in(world.bounds(), world.field.cell, agent.target);
         let mut walls = all_wall_shapes(world);
         walls.extend(obstacle_discs(agent, position, grid.cell, others).map(|d| d.shape()));
         let blocked = rasterize(&grid, world.bounds(), &walls, agent.radius, offsets);
-        Self::from_mask(grid, blocked, agent, position)
+        (grid, blocked)
     }
 
     /// The free space of a lidar agent at `position`: the box's edges, the discs `others`, and
@@ -204,20 +219,26 @@ impl FreeSpace {
 }
 
 /// The discs of `others` that are obstacles for `agent` at `position` on a grid of `cell`
-/// metres: all but those that cover its target or itself (see [`FreeSpace::among`]).
-pub fn obstacle_discs<'a>(
-    agent: &'a Agent,
+/// metres: all but those that cover its target (see [`FreeSpace::among`]). A disc that comes
+/// nearer the agent than [`clear_of`] allows is shrunk to what stays that clear of it (and
+/// left out when nothing is left): the agent's own cell stays free, and the neighbour at its
+/// skin still blocks the way through it, so a field never leads straight into a neighbour.
+pub fn obstacle_discs(
+    agent: &Agent,
     position: [f64; 2],
     cell: f64,
-    others: &'a [Disc],
-) -> impl Iterator<Item = &'a Disc> + 'a {
+    others: &[Disc],
+) -> impl Iterator<Item = Disc> {
     let margin = clear_of(agent, cell);
-    let covers = move |d: &Disc, p: [f64; 2]| {
-        (p[0] - d.center[0]).hypot(p[1] - d.center[1]) < d.radius + margin
-    };
-    others
-        .iter()
-        .filter(move |d| !covers(d, agent.target) && !covers(d, position))
+    let (target, others) = (agent.target, others.to_vec());
+    others.into_iter().filter_map(move |d| {
+        let from = |p: [f64; 2]| (p[0] - d.center[0]).hypot(p[1] - d.center[1]);
+        if from(target) < d.radius + margin {
+            return None;
+        }
+        let radius = d.radius.min(from(position) - margin);
+        (radius > 0.0).then_some(Disc { radius, ..d })
+    })
 }
 
 /// How far beyond its own radius a disc must stay from `agent`'s centre, on a grid of `cell`

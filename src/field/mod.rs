@@ -41,6 +41,7 @@ mod scaled;
 mod space;
 mod streamline;
 mod window;
+mod yielding;
 
 pub use firas::AttractiveRepulsive;
 pub use grid::Grid;
@@ -58,6 +59,7 @@ pub use scaled::ScaledW;
 pub use space::ConfigurationSpace;
 pub use streamline::Streamline;
 pub use window::Window;
+pub use yielding::{CLEAR_OF_WAY, IN_THE_WAY, WAY_AHEAD, Way};
 
 /// The solver's internals, public for the benchmarks only: not part of the crate's API.
 #[doc(hidden)]

@@ -160,7 +160,6 @@ impl Window {
                 let r = d.radius + agent.radius + half.max(reach);
                 (d.center[0] - position[0]).abs() < r && (d.center[1] - position[1]).abs() < r
             })
-            .copied()
             .collect();
         let reusable = previous.and_then(|p| p.coarse.as_ref()).filter(|c| {
             c.reused < COARSE_REUSE

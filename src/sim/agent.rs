@@ -29,7 +29,9 @@ use crate::control::{
     ControlOutput, Controller, ENVELOPE_MARGIN, Envelope, Enveloped, Neighbour, Orca, Step, Sweep,
     unit,
 };
-use crate::field::{Beam, Disc, FieldError, GuidanceField, HarmonicField, KnownMap, Streamline};
+use crate::field::{
+    Beam, Disc, FieldError, GuidanceField, HarmonicField, KnownMap, Streamline, WAY_AHEAD, Way,
+};
 use crate::metrics::{Metrics, Summary};
 use crate::world::{Agent, ControllerKind, GuidanceKind, Replan, SensorKind, WallShape, World};
 
@@ -84,6 +86,14 @@ pub struct AgentRun {
     log: StepLog,
     /// A force commanded from outside (see [`AgentRun::command`]), N.
     command: Option<Vector2<f64>>,
+    /// Its way: the next metres of its guidance at the last replan, which the agents after it
+    /// give way to (see `field/yielding.rs`).
+    way: Option<Way>,
+    /// Whether its field is one that takes it out of another's way.
+    yielding: bool,
+    /// Whether it has come within its band of the target (once is enough: from then on it
+    /// gives way to every agent that has not).
+    arrived: bool,
 }
 
 /// An agent's body: a disc pushed in any direction, or a robot on wheels steered by its
@@ -144,6 +154,8 @@ struct StepLog {
     scan: Option<Vec<Beam>>,
     wheels: Option<Wheels>,
     enveloped: bool,
+    /// The order of way changed its field (see [`Replanned`]).
+    turned: bool,
 }
 
 /// An agent's part of a step, read before any field is re-solved.
@@ -165,12 +177,27 @@ pub struct Plan {
     /// Whether what the walls' part of the field is solved from changed (a sensor reading,
     /// the lidar's map), so a local replan must re-solve that part too.
     walls_changed: bool,
+    /// Which of `others` are the agents after this one, which give way to it.
+    after: Vec<usize>,
+    /// The ways of the agents before this one, which it gives way to (when it rebuilds).
+    ways: Vec<Way>,
 }
 
-/// A re-solved field, and the field of the walls it was solved on when that was re-solved too.
+/// What an agent knows of another for the order of way: its way and its
+/// [`AgentRun::right_of_way`].
+pub type CrowdMember = (Option<Way>, (bool, usize));
+
+/// A re-solved field, the field of the walls it was solved on when that was re-solved too,
+/// how the order of way made it, and the way it gives the agent.
 pub struct Replanned {
     field: HarmonicField,
     walls: Option<HarmonicField>,
+    /// It takes the agent out of another's way.
+    yielded: bool,
+    /// The order of way chose it (a yield, or a field past the agents after this one): the
+    /// agent may turn about on it, by the rule and not at a critical point of its field.
+    by_rule: bool,
+    way: Option<Way>,
 }
 
 /// What happened to one agent in the last step, for recording.
@@ -306,7 +333,28 @@ impl AgentRun {
             external: Vector2::from(world.external_acceleration),
             log: StepLog::default(),
             command: None,
+            way: None,
+            yielding: false,
+            arrived: false,
         }
+    }
+
+    /// Its way at the last replan (see `field/yielding.rs`): what the agents after it keep
+    /// out of; `None` before its first replan among others.
+    pub fn way(&self) -> Option<&Way> {
+        self.way.as_ref()
+    }
+
+    /// Whether its field is taking it out of another agent's way.
+    pub fn is_yielding(&self) -> bool {
+        self.yielding
+    }
+
+    /// Its place in the order of way (see `field/yielding.rs`), for its `index` in the world:
+    /// the agents that have not yet arrived first, in the world's order, then those that
+    /// have. The lower goes first.
+    pub fn right_of_way(&self, index: usize) -> (bool, usize) {
+        (self.arrived, index)
     }
 
     /// Commands the force applied to the body from the next step on, N, instead of its control
@@ -378,13 +426,16 @@ impl AgentRun {
 
     /// Step 1: reads the state, takes a sensor reading of the `walls` if one is due at `time`
     /// (s), and decides whether the field is rebuilt with the `others` where they are now
-    /// (an ORCA agent's field has the walls only: ORCA steers it among the others).
+    /// (an ORCA agent's field has the walls only: ORCA steers it among the others). The
+    /// `others` are the agents but this one, at `index` of the `crowd` (every agent's way and
+    /// [`AgentRun::right_of_way`]), in order, then the moving obstacles.
     pub(super) fn plan(
         &mut self,
         physics: &PhysicsWorld,
         time: f64,
         (world, walls): (&World, &[WallShape]),
         others: Vec<Neighbour>,
+        (index, crowd): (usize, &[CrowdMember]),
     ) -> Plan {
         let (x, v) = self.read_state(physics);
         let mut plan = Plan {
@@ -396,6 +447,8 @@ impl AgentRun {
             neighbours: Vec::new(),
             rebuild: false,
             walls_changed: false,
+            after: Vec::new(),
+            ways: Vec::new(),
         };
         if self.frozen {
             return plan;
@@ -451,6 +504,19 @@ impl AgentRun {
         }
         plan.walls_changed = plan.sensed_now || map_changed;
         plan.rebuild = plan.walls_changed || replan_due;
+        if plan.rebuild && index < crowd.len() {
+            // Agent k is `others[k]` before this one and `others[k - 1]` after it.
+            let mine = crowd[index].1;
+            let before = |k: usize| k != index && crowd[k].1 < mine;
+            plan.ways = (0..crowd.len())
+                .filter(|&k| before(k))
+                .filter_map(|k| crowd[k].0.clone())
+                .collect();
+            plan.after = (0..crowd.len())
+                .filter(|&k| k != index && !before(k))
+                .map(|k| if k < index { k } else { k - 1 })
+                .collect();
+        }
         plan
     }
 
@@ -464,6 +530,10 @@ impl AgentRun {
     ///
     /// A window cut off from the target or the field's way on (see [`HarmonicField::with_window`])
     /// falls back to the full re-solve for that replan.
+    ///
+    /// An agent stuck among the others gives way to the agents before it or plans past the
+    /// ones after it, by the rule of `field/yielding.rs`; the new field's way is published for
+    /// the agents after it.
     pub(super) fn resolve(
         &self,
         plan: &Plan,
@@ -494,12 +564,10 @@ impl AgentRun {
                 Some(field),
             ),
         };
-        if !local {
-            return Some(solve(&plan.others).map(|field| Replanned { field, walls: None }));
-        }
         // The field of the walls: solved again when they were sensed anew, else the one kept,
         // with the last window (whose work the new one may reuse) if the field has one.
         let (walls, new_walls) = match &self.walls {
+            _ if !local => (field.clone(), None),
             Some(walls) if !plan.walls_changed => (
                 HarmonicField {
                     window: field.window.clone(),
@@ -512,20 +580,83 @@ impl AgentRun {
                 Err(e) => return Some(Err(e)),
             },
         };
-        let field = if plan.others.is_empty() {
-            Ok(walls.without_window())
-        } else {
-            match walls.with_window(&self.agent, plan.x.into(), &plan.others, &world.field) {
-                // Cut off, or the way on blocked in the window: whether a detour exists beyond
-                // it (and which) only the whole field can say.
-                Err(FieldError::Unreachable { .. }) => solve(&plan.others),
-                result => result,
+        // The field among the discs `others`: in a window on the field of the walls, or the
+        // whole field when the window is cut off or its way on is blocked in it (whether a
+        // detour exists beyond the window, and which, only the whole field can say).
+        let among = |others: &[Disc]| {
+            if !local {
+                solve(others)
+            } else if others.is_empty() {
+                Ok(walls.without_window())
+            } else {
+                match walls.with_window(&self.agent, plan.x.into(), others, &world.field) {
+                    Err(FieldError::Unreachable { .. }) => solve(others),
+                    // A window whose guidance at the agent turns back on the last field's:
+                    // the window moved with the agent and the field of the walls on its edge
+                    // disagrees with the others beyond it (at a crowd parked by a door, the
+                    // agent turns back and forth between two windows for good). Which way is
+                    // right only the whole field can say.
+                    Ok(window) if turns_back(field, &window, plan.x) => solve(others),
+                    result => result,
+                }
             }
         };
-        Some(field.map(|field| Replanned {
-            field,
-            walls: new_walls,
-        }))
+        let way_of = |field: &HarmonicField| self.way_of(field, plan.x);
+        let done = |field: HarmonicField, (yielded, by_rule): (bool, bool)| {
+            let way = Some(way_of(&field));
+            Ok(Replanned {
+                field,
+                walls: new_walls.clone(),
+                yielded,
+                by_rule,
+                way,
+            })
+        };
+        let first = among(&plan.others);
+        // Stuck among the others (see `field/yielding.rs`): they close every way, or the way
+        // the field gives runs into one of them (one at the agent's skin).
+        let cell = world.field.cell;
+        let unreachable = matches!(first, Err(FieldError::Unreachable { .. }));
+        let stuck = match &first {
+            Err(_) => unreachable && !plan.others.is_empty(),
+            Ok(f) => {
+                let way = way_of(f);
+                plan.others.iter().any(|d| way.runs_into(d, cell))
+            }
+        };
+        let me = Disc {
+            center: plan.x.into(),
+            radius: self.agent.radius,
+        };
+        // An agent before it planned past it (it is after that one, or on its target).
+        let overrun = plan.ways.iter().any(|w| w.runs_into(&me, cell));
+        if !stuck && !overrun {
+            return Some(first.and_then(|f| done(f, (false, false))));
+        }
+        let blocked: Vec<&Way> = plan.ways.iter().filter(|w| w.in_the_way(&me)).collect();
+        if !blocked.is_empty() && self.lidar.is_none() {
+            let others = (self.offsets.as_slice(), plan.others.as_slice());
+            if let Ok(aside) =
+                HarmonicField::yielding(world, &self.agent, plan.x.into(), others, &blocked)
+            {
+                return Some(done(aside, (true, true)));
+            }
+        }
+        if unreachable && !plan.after.is_empty() {
+            // In no one's way: the agents after it give way to it.
+            let before: Vec<Disc> = (plan.others.iter().enumerate())
+                .filter(|(k, _)| !plan.after.contains(k))
+                .map(|(_, d)| *d)
+                .collect();
+            return Some(among(&before).and_then(|f| done(f, (false, true))));
+        }
+        Some(first.and_then(|f| done(f, (false, false))))
+    }
+
+    /// The way `field` gives a body at `x` (see [`Way`]).
+    fn way_of(&self, field: &HarmonicField, x: Vector2<f64>) -> Way {
+        let ahead = field.streamline_within(x.into(), WAY_AHEAD + field.grid().cell);
+        Way::new(&ahead, self.agent.radius)
     }
 
     /// Its remaining sweep at the start of the step of `plan` (see [`Envelope`]): its disc
@@ -682,6 +813,7 @@ impl AgentRun {
             position,
             signed_clearance: signed,
             bounds,
+            giving_way: self.yielding || self.log.turned,
         });
         self.log.events.extend(faults);
         // A disc at or inside a wall touches it, whatever Rapier's narrow phase has seen yet
@@ -703,13 +835,15 @@ impl AgentRun {
             metrics.record(&wheels, centre);
         }
         self.metrics.record_state(time, position, velocity, signed);
+        let distance = (position - Vector2::from(self.agent.target)).norm();
+        self.arrived |= distance <= self.metrics.band();
         let log = std::mem::take(&mut self.log);
         let control = log.control;
         AgentState {
             position,
             velocity,
             force: control.map_or(Vector2::zeros(), |c| c.force),
-            distance: (position - Vector2::from(self.agent.target)).norm(),
+            distance,
             radial_speed,
             potential: self.field.potential(p),
             clearance,
@@ -755,6 +889,15 @@ impl AgentRun {
         match (&mut self.field, solved) {
             (GuidanceField::Harmonic(field), Some(Ok(new))) => {
                 *field = new.field;
+                if new.yielded && !self.yielding {
+                    self.log.notes.push(format!(
+                        "stuck among the others in the way of an agent before it at t = {:.2} s; steps aside",
+                        plan.time
+                    ));
+                }
+                self.log.turned = new.by_rule || self.yielding;
+                self.yielding = new.yielded;
+                self.way = new.way;
                 if let Some(walls) = new.walls {
                     self.walls = Some(walls);
                 }
@@ -795,7 +938,10 @@ impl AgentRun {
                     ));
                 }
             }
-            (GuidanceField::Harmonic(_), Some(Err(e))) => {
+            (GuidanceField::Harmonic(field), Some(Err(e))) => {
+                // The field kept is the way it goes on.
+                let ahead = field.streamline_within(plan.x.into(), WAY_AHEAD + field.grid().cell);
+                self.way = Some(Way::new(&ahead, self.agent.radius));
                 if !self.rebuild_failed {
                     self.log.notes.push(format!(
                         "the sensed walls and the other agents give no usable field ({e}); keeping the last one"
@@ -1046,6 +1192,13 @@ fn boundary(field: &HarmonicField) -> Vec<[f64; 2]> {
         }
     }
     points
+}
+
+/// Whether the guidance of `new` at `x` points against that of `last` (their gradients'
+/// angle above 90°).
+fn turns_back(last: &HarmonicField, new: &HarmonicField, x: Vector2<f64>) -> bool {
+    let at = |f: &HarmonicField| f.gradient(x.into()).and_then(|g| unit(&g));
+    at(last).zip(at(new)).is_some_and(|(a, b)| a.dot(&b) < 0.0)
 }
 
 /// Whether `collider` is a moving obstacle's (on a kinematic body).

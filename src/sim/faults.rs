@@ -38,6 +38,10 @@ pub struct Observation<'a> {
     pub signed_clearance: f64,
     /// The world's box, its lower-left and upper-right corners, m.
     pub bounds: ([f64; 2], [f64; 2]),
+    /// Whether the order of way among agents rules the field (`field/yielding.rs`): taking the
+    /// agent out of another's way (flat where it waits), or just changed by the rule (it may
+    /// turn about). Neither is a critical point of a field: no fault.
+    pub giving_way: bool,
 }
 
 impl FaultMonitor {
@@ -83,7 +87,7 @@ impl FaultMonitor {
                 .w_and_grad_scaled(p)
                 .is_some_and(|(w, g)| g.norm() * cell <= FLAT_RELATIVE_CHANGE * w)
         });
-        let lost = !near_target && (direction.is_none() || flat || reversed);
+        let lost = !near_target && !o.giving_way && (direction.is_none() || flat || reversed);
         if lost {
             self.faults.guidance_lost_steps += 1;
             if !self.guidance_lost {

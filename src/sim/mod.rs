@@ -198,6 +198,10 @@ impl Simulation {
         let seen = sighted(&self.obstacles, 0.0);
         let ahead = sighted(&self.obstacles, self.world.field.obstacle_horizon);
         let scene = (&self.world, self.walls.as_slice());
+        // Who gives way to whom (see `field/yielding.rs`): each agent's way and its place.
+        let crowd: Vec<_> = (self.agents.iter().enumerate())
+            .map(|(i, a)| (a.way().cloned(), a.right_of_way(i)))
+            .collect();
         let plans: Vec<_> = (self.agents.iter_mut().enumerate())
             .map(|(i, a)| {
                 // ORCA extrapolates the velocities itself; a field is solved on where the
@@ -205,7 +209,7 @@ impl Simulation {
                 let orca = a.agent.controller.kind == ControllerKind::Orca;
                 let obstacles = if orca { &seen } else { &ahead };
                 let others = seen_by(&bodies, obstacles, i, a.lidar.is_some());
-                a.plan(&self.physics, self.time, scene, others)
+                a.plan(&self.physics, self.time, scene, others, (i, &crowd))
             })
             .collect();
         // Each re-solve reads only its own agent, so the results do not depend on the threads.

@@ -1,0 +1,274 @@
+//! Giving way in a crowd: an agent's [`Way`] (the next metres of its guidance) and the field
+//! that takes an agent that blocks a way out of it ([`HarmonicField::yielding`]).
+//!
+//! **Why it is needed.** With local replanning each agent's field has the others as
+//! obstacles. Two groups that meet in a door close it for each other: every field is
+//! [`FieldError::Unreachable`](super::FieldError::Unreachable), every agent keeps its last
+//! field, which leads into the door, and the clearance envelope (rightly) stops them short of
+//! each other. Nobody touches, and nobody moves: a deadlock, not a collision.
+//!
+//! **The rule.** The agents have an order of way: first those that have not yet arrived at
+//! their targets, in the world file's order, then those that have (once arrived, an agent
+//! stays in the second group even if it is moved off again). At each replan an agent is
+//! *stuck* when its field with all the others is unreachable, or when the way that field gives
+//! it runs into a neighbour's disc (a neighbour at its skin, which a field cannot keep apart);
+//! it is *overrun* when the way of an agent before it runs into its disc (that agent planned
+//! past it). A stuck or overrun agent that stands in the way of agents before it (its disc
+//! within [`IN_THE_WAY`] of their ways) *yields*: its field leads, among the walls and all the
+//! others, to the nearest free cells at least [`CLEAR_OF_WAY`] clear of those ways
+//! ([`HarmonicField::yielding`]). A stuck agent in no one's way plans among the agents before
+//! it only (and the moving obstacles): the ones after it give way. Otherwise it keeps the
+//! field it has (the one that took it out of the way, when it yielded).
+//!
+//! **Why the crowd then moves.** Take the first agent in the order that has not arrived. It
+//! never yields: when it is stuck it plans among the moving obstacles alone, so its field leads
+//! on while the walls leave a way, and every agent standing on that way is overrun or stuck
+//! in its way and leaves it, if it has free space to leave into. So it arrives in finite time
+//! and drops to the second group; the order changes at most once per agent, and the argument
+//! repeats for the next. The clearance envelope holds under all of it (a yield is only another
+//! field), so no one touches on the way. What the rule cannot do is make room where there is
+//! none: an agent with no free cell clear of the ways that it can reach keeps its field and
+//! waits, and the run reports whom that left short of the target.
+
+use std::sync::Arc;
+
+use nalgebra::Vector2;
+
+use super::grid::Grid;
+use super::laplace;
+use super::mask::{Disc, FreeSpace};
+use super::streamline::Streamline;
+use super::{FieldError, HarmonicField};
+use crate::world::{Agent, World};
+
+/// How much of its guidance an agent publishes as its way, m: the next few seconds at a
+/// walking robot's speed, enough to see a door ahead emptied before it is entered.
+pub const WAY_AHEAD: f64 = 4.0;
+
+/// How near a disc must come to a way to stand in it, m, beyond the two radii.
+pub const IN_THE_WAY: f64 = 0.1;
+
+/// How far clear of the ways, m beyond the two radii, a yielding agent goes: a margin
+/// the envelope's stopping distance and the replan's horizon fit in at walking speed.
+pub const CLEAR_OF_WAY: f64 = 0.5;
+
+/// The next metres of an agent's guidance: the streamline of its field from where it is,
+/// at most [`WAY_AHEAD`] long, and the radius of the disc that follows it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Way {
+    /// Points along the way, m, from the agent's position.
+    pub points: Arc<[[f64; 2]]>,
+    /// The agent's radius, m.
+    pub radius: f64,
+}
+
+impl Way {
+    /// The first [`WAY_AHEAD`] metres of `streamline` for a disc of `radius` m.
+    ///
+    /// ```
+    /// use nadf::field::{Streamline, Way};
+    /// let line = Streamline { points: (0..100).map(|i| [0.1 * i as f64, 0.0]).collect(), reached: true };
+    /// let way = Way::new(&line, 0.3);
+    /// assert!((way.points.last().unwrap()[0] - 4.0).abs() < 0.11);
+    /// ```
+    pub fn new(streamline: &Streamline, radius: f64) -> Self {
+        let mut points = Vec::new();
+        let mut walked = 0.0;
+        for (k, p) in streamline.points.iter().enumerate() {
+            if k > 0 {
+                let q = streamline.points[k - 1];
+                walked += (p[0] - q[0]).hypot(p[1] - q[1]);
+            }
+            points.push(*p);
+            if walked >= WAY_AHEAD {
+                break;
+            }
+        }
+        Self {
+            points: points.into(),
+            radius,
+        }
+    }
+
+    /// Distance from `p` to the way's polyline, m (infinite for a way with no points).
+    pub fn distance(&self, p: [f64; 2]) -> f64 {
+        let p = Vector2::from(p);
+        match self.points.as_ref() {
+            [] => f64::INFINITY,
+            [a] => (p - Vector2::from(*a)).norm(),
+            points => points
+                .windows(2)
+                .map(|s| {
+                    let (a, b) = (Vector2::from(s[0]), Vector2::from(s[1]));
+                    let ab = b - a;
+                    let t = ((p - a).dot(&ab) / ab.norm_squared().max(f64::MIN_POSITIVE))
+                        .clamp(0.0, 1.0);
+                    (p - (a + ab * t)).norm()
+                })
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+
+    /// Whether `disc` stands in the way: within [`IN_THE_WAY`] of the disc that follows it.
+    pub fn in_the_way(&self, disc: &Disc) -> bool {
+        self.distance(disc.center) < self.radius + disc.radius + IN_THE_WAY
+    }
+
+    /// Whether the way runs into `disc`: the disc that follows it overlaps it by more than
+    /// `slack` m somewhere (not counting its first point, where the agent is now).
+    pub fn runs_into(&self, disc: &Disc, slack: f64) -> bool {
+        let ahead = Self {
+            points: self.points.get(1..).unwrap_or_default().into(),
+            radius: self.radius,
+        };
+        ahead.distance(disc.center) < self.radius + disc.radius - slack
+    }
+
+    /// Whether a disc of `radius` m centred at `p` is at least [`CLEAR_OF_WAY`] clear of the
+    /// way.
+    pub fn clear(&self, p: [f64; 2], radius: f64) -> bool {
+        self.distance(p) >= self.radius + radius + CLEAR_OF_WAY
+    }
+}
+
+impl FreeSpace {
+    /// The free space of `agent` at `position` on the mask `blocked` (on `grid`, the walls
+    /// and all the other agents) whose "target" is every cell connected to the agent and clear
+    /// of the `ways` (see [`Way::clear`]): where a yielding agent goes. `None` when no such
+    /// cell can be reached, or the agent's own cell is blocked.
+    pub fn out_of_ways(
+        grid: &Grid,
+        blocked: &[bool],
+        agent: &Agent,
+        position: [f64; 2],
+        ways: &[&Way],
+    ) -> Option<Self> {
+        let here = grid
+            .cell_of(position)
+            .filter(|&(i, j)| !blocked[grid.index(i, j)])?;
+        let connected = laplace::reachable_from(grid, blocked, here);
+        let target_cells: Vec<usize> = (0..grid.len())
+            .filter(|&k| connected[k])
+            .filter(|&k| {
+                let p = grid.center(k % grid.nx, k / grid.nx);
+                ways.iter().all(|w| w.clear(p, agent.radius))
+            })
+            .collect();
+        let first = *target_cells.first()?;
+        Some(Self {
+            grid: *grid,
+            blocked: blocked.to_vec(),
+            target_cell: (first % grid.nx, first / grid.nx),
+            target_cells,
+            reachable: connected,
+        })
+    }
+}
+
+impl HarmonicField {
+    /// The field that takes `agent` at `position` out of the `ways` of the agents it stands in
+    /// the way of, among the walls and the `others` (all the other agents): `W = 1` on every
+    /// free cell connected to it and clear of the ways (see [`FreeSpace::out_of_ways`]), so it
+    /// leads to the nearest of them by the harmonic field's own argument (no local minimum).
+    /// Its `target` stays the agent's, so it is the agent's field in every other respect.
+    ///
+    /// [`FieldError::Unreachable`] when there is nowhere to go.
+    pub fn yielding(
+        world: &World,
+        agent: &Agent,
+        position: [f64; 2],
+        (offsets, others): (&[f64], &[Disc]),
+        ways: &[&Way],
+    ) -> Result<Self, FieldError> {
+        let started = std::time::Instant::now();
+        let (grid, blocked) = FreeSpace::mask_among(world, agent, position, offsets, others);
+        let space =
+            FreeSpace::out_of_ways(&grid, &blocked, agent, position, ways).ok_or_else(|| {
+                FieldError::Unreachable {
+                    agent: agent.name.clone(),
+                    radius: agent.radius,
+                }
+            })?;
+        Self::solve_space(world, agent, space, None, started)
+    }
+}
+
+/// The cells of `grid` whose centres are within `radius` of `center`, reachable or not (for
+/// tests: a way's neighbourhood).
+#[cfg(test)]
+fn cells_near(grid: &Grid, center: [f64; 2], radius: f64) -> Vec<usize> {
+    super::mask::disc_cells(grid, &vec![true; grid.len()], center, radius)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn straight(from: [f64; 2], to: [f64; 2], n: usize) -> Streamline {
+        Streamline {
+            points: (0..=n)
+                .map(|k| {
+                    let t = k as f64 / n as f64;
+                    [
+                        from[0] + t * (to[0] - from[0]),
+                        from[1] + t * (to[1] - from[1]),
+                    ]
+                })
+                .collect(),
+            reached: true,
+        }
+    }
+
+    #[test]
+    fn a_way_is_the_first_metres_of_the_streamline() {
+        let way = Way::new(&straight([0.0, 0.0], [10.0, 0.0], 100), 0.3);
+        let end = way.points.last().unwrap();
+        assert!((end[0] - WAY_AHEAD).abs() <= 0.1 + 1e-9, "{end:?}");
+        assert_eq!(way.distance([2.0, 0.5]), 0.5);
+        // Beyond its end the way is not there.
+        assert!((way.distance([8.0, 0.0]) - (8.0 - end[0])).abs() < 1e-12);
+    }
+
+    #[test]
+    fn in_the_way_runs_into_and_clear() {
+        let way = Way::new(&straight([0.0, 0.0], [4.0, 0.0], 40), 0.3);
+        let disc = |y: f64| Disc {
+            center: [2.0, y],
+            radius: 0.3,
+        };
+        assert!(way.in_the_way(&disc(0.65)));
+        assert!(!way.in_the_way(&disc(0.75)));
+        assert!(way.runs_into(&disc(0.5), 0.05));
+        assert!(!way.runs_into(&disc(0.58), 0.05));
+        // At the agent itself (the way's first point) nothing is run into.
+        let at_start = Disc {
+            center: [-0.5, 0.0],
+            radius: 0.3,
+        };
+        assert!(!way.runs_into(&at_start, 0.0));
+        assert!(!way.clear([2.0, 1.0], 0.3) && way.clear([2.0, 1.2], 0.3));
+    }
+
+    #[test]
+    fn the_space_out_of_a_way_is_the_free_cells_clear_of_it() {
+        let grid = Grid::covering([4.0, 4.0], 0.1);
+        let blocked = vec![false; grid.len()];
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/swap.toml");
+        let world = crate::world::load(&path, &[]).unwrap();
+        let agent = Agent {
+            radius: 0.3,
+            ..world.agents[0].clone()
+        };
+        let way = Way::new(&straight([0.0, 2.0], [4.0, 2.0], 40), 0.3);
+        let space = FreeSpace::out_of_ways(&grid, &blocked, &agent, [2.0, 2.0], &[&way]).unwrap();
+        // Every target cell is clear of the way; the cells near it are not targets.
+        for &k in &space.target_cells {
+            let p = grid.center(k % grid.nx, k / grid.nx);
+            assert!((p[1] - 2.0).abs() >= 1.1 - 1e-9, "{p:?}");
+        }
+        for k in cells_near(&grid, [2.0, 2.0], 1.0) {
+            assert!(!space.target_cells.contains(&k));
+        }
+        assert!(!space.target_cells.is_empty());
+    }
+}
