@@ -21,7 +21,7 @@ pub struct Disc {
 impl Disc {
     /// The disc grown by `by` metres, but no further than stays clear of `agent` at `position`
     /// on a grid of `cell` metres: a disc that comes nearer is shrunk in the agent's field
-    /// (see [`obstacle_discs`]), and growing must not make it vanish.
+    /// (see `obstacle_discs`), and growing must not make it vanish.
     pub fn grown(self, by: f64, (agent, position): (&Agent, [f64; 2]), cell: f64) -> Self {
         let distance = (position[0] - self.center[0]).hypot(position[1] - self.center[1]);
         let room = distance - self.radius - clear_of(agent, cell);
@@ -70,7 +70,7 @@ impl FreeSpace {
     /// with errors (wall `k` of [`all_wall_shapes`] moved out by `offsets[k]` m, see
     /// `rasterize`), and the discs `others` (the other agents) as obstacles too.
     /// A disc that covers the agent's target is left out, and one at the agent's skin is
-    /// shrunk to stay clear of its cell ([`obstacle_discs`]): an agent parked on another's
+    /// shrunk to stay clear of its cell (`obstacle_discs`): an agent parked on another's
     /// target must not make that target unreachable for good, and two agents in contact must
     /// still each have a field (the contact is counted by the simulation).
     pub fn among(
@@ -86,7 +86,7 @@ impl FreeSpace {
 
     /// The grid and mask of [`FreeSpace::among`], before anything is checked to connect: the
     /// walls sensed with `offsets` and the discs `others` that are obstacles for `agent` at
-    /// `position` (see [`obstacle_discs`]).
+    /// `position` (see `obstacle_discs`).
     pub fn mask_among(
         world: &World,
         agent: &Agent,
@@ -223,15 +223,14 @@ impl FreeSpace {
 /// nearer the agent than [`clear_of`] allows is shrunk to what stays that clear of it (and
 /// left out when nothing is left): the agent's own cell stays free, and the neighbour at its
 /// skin still blocks the way through it, so a field never leads straight into a neighbour.
-pub fn obstacle_discs(
+pub fn obstacle_discs<'a>(
     agent: &Agent,
     position: [f64; 2],
     cell: f64,
-    others: &[Disc],
-) -> impl Iterator<Item = Disc> {
-    let margin = clear_of(agent, cell);
-    let (target, others) = (agent.target, others.to_vec());
-    others.into_iter().filter_map(move |d| {
+    others: &'a [Disc],
+) -> impl Iterator<Item = Disc> + 'a {
+    let (margin, target) = (clear_of(agent, cell), agent.target);
+    others.iter().filter_map(move |&d| {
         let from = |p: [f64; 2]| (p[0] - d.center[0]).hypot(p[1] - d.center[1]);
         if from(target) < d.radius + margin {
             return None;

@@ -61,13 +61,7 @@ pub fn integrate(
 impl Streamline {
     /// Distance from `p` to the polyline, m.
     pub fn distance_to(&self, p: [f64; 2]) -> f64 {
-        let p = Vector2::from(p);
-        if self.points.len() == 1 {
-            return (p - Vector2::from(self.points[0])).norm();
-        }
-        (0..self.points.len() - 1)
-            .map(|s| self.segment_distance(s, p))
-            .fold(f64::INFINITY, f64::min)
+        polyline_distance(&self.points, p)
     }
 
     /// The largest distance from any of `points` to the polyline, m (0 for none): `δ_m` of a
@@ -117,13 +111,7 @@ impl Streamline {
 
     /// Distance from `p` to segment `s` (from point `s` to point `s + 1`), m.
     fn segment_distance(&self, s: usize, p: Vector2<f64>) -> f64 {
-        let (a, b) = (
-            Vector2::from(self.points[s]),
-            Vector2::from(self.points[s + 1]),
-        );
-        let ab = b - a;
-        let t = ((p - a).dot(&ab) / ab.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-        (p - (a + ab * t)).norm()
+        segment_distance(self.points[s], self.points[s + 1], p)
     }
 
     /// Length of the polyline, m.
@@ -133,6 +121,27 @@ impl Streamline {
             .map(|s| (s[1][0] - s[0][0]).hypot(s[1][1] - s[0][1]))
             .sum()
     }
+}
+
+/// Distance from `p` to the polyline through `points`, m: to the point itself for one point,
+/// infinite for none.
+pub(super) fn polyline_distance(points: &[[f64; 2]], p: [f64; 2]) -> f64 {
+    let p = Vector2::from(p);
+    match points {
+        [] => f64::INFINITY,
+        [a] => (p - Vector2::from(*a)).norm(),
+        _ => (points.windows(2))
+            .map(|s| segment_distance(s[0], s[1], p))
+            .fold(f64::INFINITY, f64::min),
+    }
+}
+
+/// Distance from `p` to the segment from `a` to `b`, m.
+fn segment_distance(a: [f64; 2], b: [f64; 2], p: Vector2<f64>) -> f64 {
+    let (a, b) = (Vector2::from(a), Vector2::from(b));
+    let ab = b - a;
+    let t = ((p - a).dot(&ab) / ab.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+    (p - (a + ab * t)).norm()
 }
 
 #[cfg(test)]

@@ -32,8 +32,6 @@
 
 use std::sync::Arc;
 
-use nalgebra::Vector2;
-
 use super::grid::Grid;
 use super::laplace;
 use super::mask::{Disc, FreeSpace};
@@ -92,21 +90,7 @@ impl Way {
 
     /// Distance from `p` to the way's polyline, m (infinite for a way with no points).
     pub fn distance(&self, p: [f64; 2]) -> f64 {
-        let p = Vector2::from(p);
-        match self.points.as_ref() {
-            [] => f64::INFINITY,
-            [a] => (p - Vector2::from(*a)).norm(),
-            points => points
-                .windows(2)
-                .map(|s| {
-                    let (a, b) = (Vector2::from(s[0]), Vector2::from(s[1]));
-                    let ab = b - a;
-                    let t = ((p - a).dot(&ab) / ab.norm_squared().max(f64::MIN_POSITIVE))
-                        .clamp(0.0, 1.0);
-                    (p - (a + ab * t)).norm()
-                })
-                .fold(f64::INFINITY, f64::min),
-        }
+        super::streamline::polyline_distance(&self.points, p)
     }
 
     /// Whether `disc` stands in the way: within [`IN_THE_WAY`] of the disc that follows it.
@@ -117,11 +101,8 @@ impl Way {
     /// Whether the way runs into `disc`: the disc that follows it overlaps it by more than
     /// `slack` m somewhere (not counting its first point, where the agent is now).
     pub fn runs_into(&self, disc: &Disc, slack: f64) -> bool {
-        let ahead = Self {
-            points: self.points.get(1..).unwrap_or_default().into(),
-            radius: self.radius,
-        };
-        ahead.distance(disc.center) < self.radius + disc.radius - slack
+        let ahead = self.points.get(1..).unwrap_or_default();
+        super::streamline::polyline_distance(ahead, disc.center) < self.radius + disc.radius - slack
     }
 
     /// Whether a disc of `radius` m centred at `p` is at least [`CLEAR_OF_WAY`] clear of the

@@ -345,11 +345,6 @@ impl AgentRun {
         self.way.as_ref()
     }
 
-    /// Whether its field is taking it out of another agent's way.
-    pub fn is_yielding(&self) -> bool {
-        self.yielding
-    }
-
     /// Its place in the order of way (see `field/yielding.rs`), for its `index` in the world:
     /// the agents that have not yet arrived first, in the world's order, then those that
     /// have. The lower goes first.
@@ -601,28 +596,29 @@ impl AgentRun {
                 }
             }
         };
-        let way_of = |field: &HarmonicField| self.way_of(field, plan.x);
-        let done = |field: HarmonicField, (yielded, by_rule): (bool, bool)| {
-            let way = Some(way_of(&field));
+        // The replanned field with the way it gives (computed here unless `way` has it).
+        let done = |field: HarmonicField, way: Option<Way>, (yielded, by_rule): (bool, bool)| {
+            let way = way.unwrap_or_else(|| way_of(&field, plan.x, self.agent.radius));
             Ok(Replanned {
                 field,
                 walls: new_walls.clone(),
                 yielded,
                 by_rule,
-                way,
+                way: Some(way),
             })
         };
         let first = among(&plan.others);
+        let first_way = first
+            .as_ref()
+            .ok()
+            .map(|f| way_of(f, plan.x, self.agent.radius));
         // Stuck among the others (see `field/yielding.rs`): they close every way, or the way
         // the field gives runs into one of them (one at the agent's skin).
         let cell = world.field.cell;
         let unreachable = matches!(first, Err(FieldError::Unreachable { .. }));
-        let stuck = match &first {
-            Err(_) => unreachable && !plan.others.is_empty(),
-            Ok(f) => {
-                let way = way_of(f);
-                plan.others.iter().any(|d| way.runs_into(d, cell))
-            }
+        let stuck = match &first_way {
+            None => unreachable && !plan.others.is_empty(),
+            Some(way) => plan.others.iter().any(|d| way.runs_into(d, cell)),
         };
         let me = Disc {
             center: plan.x.into(),
@@ -631,7 +627,7 @@ impl AgentRun {
         // An agent before it planned past it (it is after that one, or on its target).
         let overrun = plan.ways.iter().any(|w| w.runs_into(&me, cell));
         if !stuck && !overrun {
-            return Some(first.and_then(|f| done(f, (false, false))));
+            return Some(first.and_then(|f| done(f, first_way, (false, false))));
         }
         let blocked: Vec<&Way> = plan.ways.iter().filter(|w| w.in_the_way(&me)).collect();
         if !blocked.is_empty() && self.lidar.is_none() {
@@ -639,7 +635,7 @@ impl AgentRun {
             if let Ok(aside) =
                 HarmonicField::yielding(world, &self.agent, plan.x.into(), others, &blocked)
             {
-                return Some(done(aside, (true, true)));
+                return Some(done(aside, None, (true, true)));
             }
         }
         if unreachable && !plan.after.is_empty() {
@@ -648,15 +644,9 @@ impl AgentRun {
                 .filter(|(k, _)| !plan.after.contains(k))
                 .map(|(_, d)| *d)
                 .collect();
-            return Some(among(&before).and_then(|f| done(f, (false, true))));
+            return Some(among(&before).and_then(|f| done(f, None, (false, true))));
         }
-        Some(first.and_then(|f| done(f, (false, false))))
-    }
-
-    /// The way `field` gives a body at `x` (see [`Way`]).
-    fn way_of(&self, field: &HarmonicField, x: Vector2<f64>) -> Way {
-        let ahead = field.streamline_within(x.into(), WAY_AHEAD + field.grid().cell);
-        Way::new(&ahead, self.agent.radius)
+        Some(first.and_then(|f| done(f, first_way, (false, false))))
     }
 
     /// Its remaining sweep at the start of the step of `plan` (see [`Envelope`]): its disc
@@ -940,8 +930,7 @@ impl AgentRun {
             }
             (GuidanceField::Harmonic(field), Some(Err(e))) => {
                 // The field kept is the way it goes on.
-                let ahead = field.streamline_within(plan.x.into(), WAY_AHEAD + field.grid().cell);
-                self.way = Some(Way::new(&ahead, self.agent.radius));
+                self.way = Some(way_of(field, plan.x, self.agent.radius));
                 if !self.rebuild_failed {
                     self.log.notes.push(format!(
                         "the sensed walls and the other agents give no usable field ({e}); keeping the last one"
@@ -1192,6 +1181,12 @@ fn boundary(field: &HarmonicField) -> Vec<[f64; 2]> {
         }
     }
     points
+}
+
+/// The way `field` gives a disc of `radius` m at `x` (see [`Way`]).
+fn way_of(field: &HarmonicField, x: Vector2<f64>, radius: f64) -> Way {
+    let ahead = field.streamline_within(x.into(), WAY_AHEAD + field.grid().cell);
+    Way::new(&ahead, radius)
 }
 
 /// Whether the guidance of `new` at `x` points against that of `last` (their gradients'
