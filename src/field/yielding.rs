@@ -99,7 +99,8 @@ impl Way {
     }
 
     /// Whether the way runs into `disc`: the disc that follows it overlaps it by more than
-    /// `slack` m somewhere (not counting its first point, where the agent is now).
+    /// `slack` m somewhere (not counting its first point, where the agent is now); a negative
+    /// `slack` counts a way that passes less than `−slack` m clear of the disc too.
     pub fn runs_into(&self, disc: &Disc, slack: f64) -> bool {
         let ahead = self.points.get(1..).unwrap_or_default();
         super::streamline::polyline_distance(ahead, disc.center) < self.radius + disc.radius - slack
@@ -221,6 +222,9 @@ mod tests {
         assert!(!way.in_the_way(&disc(0.75)));
         assert!(way.runs_into(&disc(0.5), 0.05));
         assert!(!way.runs_into(&disc(0.58), 0.05));
+        // A way that grazes the disc runs into it with a negative slack (a gap) only.
+        assert!(!way.runs_into(&disc(0.601), 0.0));
+        assert!(way.runs_into(&disc(0.601), -0.002) && !way.runs_into(&disc(0.603), -0.002));
         // At the agent itself (the way's first point) nothing is run into.
         let at_start = Disc {
             center: [-0.5, 0.0],

@@ -624,8 +624,14 @@ impl AgentRun {
             center: plan.x.into(),
             radius: self.agent.radius,
         };
-        // An agent before it planned past it (it is after that one, or on its target).
-        let overrun = plan.ways.iter().any(|w| w.runs_into(&me, cell));
+        // An agent before it planned past it (it is after that one, or on its target): its way
+        // comes within the envelope's margin of this disc, so the envelope would stop that
+        // agent here. The way's own overlap with the disc is no measure of it: a field threads
+        // a gap between two neighbours at its skin narrower than the two discs (they are
+        // shrunk there, see `obstacle_discs`), and an agent held in such a gap is held for good
+        // unless the neighbours give way (measured: two groups swapping through a door, 4 of 16
+        // robots in with the one-cell slack of `stuck`, 16 of 16 with this one).
+        let overrun = (plan.ways.iter()).any(|w| w.runs_into(&me, -ENVELOPE_MARGIN));
         if !stuck && !overrun {
             return Some(first.and_then(|f| done(f, first_way, (false, false))));
         }
