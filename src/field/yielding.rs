@@ -12,8 +12,9 @@
 //! stays in the second group even if it is moved off again). At each replan an agent is
 //! *stuck* when its field with all the others is unreachable, or when the way that field gives
 //! it runs into a neighbour's disc (a neighbour at its skin, which a field cannot keep apart);
-//! it is *overrun* when the way of an agent before it runs into its disc (that agent planned
-//! past it). A stuck or overrun agent that stands in the way of agents before it (its disc
+//! it is *overrun* when the way of an agent before it comes within the clearance envelope's
+//! margin of its disc (that agent planned past it, or through a gap between two neighbours at
+//! its skin narrower than the two discs: the envelope would stop it there for good). A stuck or overrun agent that stands in the way of agents before it (its disc
 //! within [`IN_THE_WAY`] of their ways) *yields*: its field leads, among the walls and all the
 //! others, to the nearest free cells at least [`CLEAR_OF_WAY`] clear of those ways
 //! ([`HarmonicField::yielding`]). A stuck agent in no one's way plans among the agents before
