@@ -14,9 +14,10 @@
 //! it runs into a neighbour's disc (a neighbour at its skin, which a field cannot keep apart);
 //! it is *overrun* when the way of an agent before it comes within the clearance envelope's
 //! margin of its disc (that agent planned past it, or through a gap between two neighbours at
-//! its skin narrower than the two discs: the envelope would stop it there for good). A stuck or overrun agent that stands in the way of agents before it (its disc
-//! within [`IN_THE_WAY`] of their ways) *yields*: its field leads, among the walls and all the
-//! others, to the nearest free cells at least [`CLEAR_OF_WAY`] clear of those ways
+//! its skin narrower than the two discs: the envelope would stop it there for good). A stuck
+//! or overrun agent that stands in the way of agents before it (its disc within
+//! [`IN_THE_WAY`] of their ways) *yields*: its field leads, among the walls and all the others,
+//! to the nearest free cells at least [`CLEAR_OF_WAY`] clear of those ways
 //! ([`HarmonicField::yielding`]). A stuck agent in no one's way plans among the agents before
 //! it only (and the moving obstacles): the ones after it give way. Otherwise it keeps the
 //! field it has (the one that took it out of the way, when it yielded).

@@ -631,7 +631,7 @@ impl AgentRun {
         // shrunk there, see `obstacle_discs`), and an agent held in such a gap is held for good
         // unless the neighbours give way (measured: two groups swapping through a door, 4 of 16
         // robots in with the one-cell slack of `stuck`, 16 of 16 with this one).
-        let overrun = (plan.ways.iter()).any(|w| w.runs_into(&me, -ENVELOPE_MARGIN));
+        let overrun = plan.ways.iter().any(|w| w.runs_into(&me, -ENVELOPE_MARGIN));
         if !stuck && !overrun {
             return Some(first.and_then(|f| done(f, first_way, (false, false))));
         }
