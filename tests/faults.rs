@@ -47,6 +47,37 @@ fn a_saddle_point_is_reported_as_lost_guidance() {
     assert_eq!(s.contacts, 0, "{s:?}");
 }
 
+/// A reversal of the guidance between two steps is a critical point only within one field:
+/// across a re-solve the two directions are two fields' (a crowd's replanned field going round
+/// a neighbour's other side), and that step is not counted.
+#[test]
+fn a_reversal_counts_within_one_field_not_across_a_resolve() {
+    let world = load(&fixture("saddle.toml"), &[]).unwrap();
+    let sim = Simulation::new(&world).unwrap();
+    let field = &sim.agents[0].field;
+    let at = |x: f64, replanned: bool| Observation {
+        field,
+        position: nalgebra::Vector2::new(x, 2.0),
+        signed_clearance: 0.5,
+        bounds: world.bounds(),
+        giving_way: false,
+        replanned,
+    };
+    // Along the axis the guidance points at the disc up to the saddle, away from it beyond.
+    let towards = |x: f64| field.gradient([x, 2.0]).unwrap()[0] < 0.0;
+    assert!(towards(1.0));
+    let beyond = (0..60)
+        .map(|k| 1.0 + 0.05 * k as f64)
+        .find(|&x| !towards(x))
+        .expect("a saddle in front of the disc");
+    for (replanned, lost) in [(false, 1), (true, 0)] {
+        let mut monitor = FaultMonitor::default();
+        monitor.observe(&at(1.0, false));
+        monitor.observe(&at(beyond + 0.1, replanned));
+        assert_eq!(monitor.faults.guidance_lost_steps, lost, "at x = {beyond}");
+    }
+}
+
 #[test]
 fn a_body_leaving_the_box_is_reported_and_the_recording_says_so() {
     let dir = tempfile::tempdir().unwrap();
@@ -108,6 +139,7 @@ fn the_monitor_counts_each_penetration_once_and_each_exit_from_the_box() {
         signed_clearance,
         bounds: world.bounds(),
         giving_way: false,
+        replanned: false,
     };
     assert!(monitor.observe(&at(1.0, 1.0, 0.5)).is_empty());
     let events = monitor.observe(&at(3.2, 2.0, -0.05));

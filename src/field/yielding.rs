@@ -20,7 +20,9 @@
 //! to the nearest free cells at least [`CLEAR_OF_WAY`] clear of those ways
 //! ([`HarmonicField::yielding`]). A stuck agent in no one's way plans among the agents before
 //! it only (and the moving obstacles): the ones after it give way. Otherwise it keeps the
-//! field it has (the one that took it out of the way, when it yielded).
+//! field it has (the one that took it out of the way, when it yielded). An agent that yielded
+//! goes on yielding while it stands in the way of an agent before it, whether or not a way
+//! still runs into it: taking its own field back sooner would lead it back into the way.
 //!
 //! **Why the crowd then moves.** Take the first agent in the order that has not arrived. It
 //! never yields: when it is stuck it plans among the moving obstacles alone, so its field leads

@@ -156,6 +156,8 @@ struct StepLog {
     enveloped: bool,
     /// The order of way changed its field (see [`Replanned`]).
     turned: bool,
+    /// Its field was solved anew in this step.
+    replanned: bool,
 }
 
 /// An agent's part of a step, read before any field is re-solved.
@@ -631,8 +633,13 @@ impl AgentRun {
         // shrunk there, see `obstacle_discs`), and an agent held in such a gap is held for good
         // unless the neighbours give way (measured: two groups swapping through a door, 4 of 16
         // robots in with the one-cell slack of `stuck`, 16 of 16 with this one).
-        let overrun = plan.ways.iter().any(|w| w.runs_into(&me, -ENVELOPE_MARGIN));
-        if !stuck && !overrun {
+        let overrun = (plan.ways.iter()).any(|w| w.runs_into(&me, -ENVELOPE_MARGIN));
+        // A yielding agent goes on yielding while it stands in the way of an agent before it:
+        // were it to take its own field back as soon as no way runs into it, it would step
+        // back into the way and be overrun again at the next replan (at a group parked by a
+        // door, the robots in front of it went back and forth by centimetres for good).
+        let still_in_the_way = self.yielding && plan.ways.iter().any(|w| w.in_the_way(&me));
+        if !stuck && !overrun && !still_in_the_way {
             return Some(first.and_then(|f| done(f, first_way, (false, false))));
         }
         let blocked: Vec<&Way> = plan.ways.iter().filter(|w| w.in_the_way(&me)).collect();
@@ -810,6 +817,7 @@ impl AgentRun {
             signed_clearance: signed,
             bounds,
             giving_way: self.yielding || self.log.turned,
+            replanned: self.log.replanned,
         });
         self.log.events.extend(faults);
         // A disc at or inside a wall touches it, whatever Rapier's narrow phase has seen yet
@@ -892,6 +900,7 @@ impl AgentRun {
                     ));
                 }
                 self.log.turned = new.by_rule || self.yielding;
+                self.log.replanned = true;
                 self.yielding = new.yielded;
                 self.way = new.way;
                 if let Some(walls) = new.walls {

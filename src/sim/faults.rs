@@ -42,6 +42,10 @@ pub struct Observation<'a> {
     /// agent out of another's way (flat where it waits), or just changed by the rule (it may
     /// turn about). Neither is a critical point of a field: no fault.
     pub giving_way: bool,
+    /// Whether its field was solved anew in this step: the last step's direction came from
+    /// another field, so a reversal from it is the new field's choice of way (round the other
+    /// side of a neighbour, back from a wall just sensed), not a critical point.
+    pub replanned: bool,
 }
 
 impl FaultMonitor {
@@ -77,8 +81,11 @@ impl FaultMonitor {
         let direction = gradient.and_then(|g| unit(&g));
         // Along a streamline the guidance turns slowly; a reversal from one step to the next
         // means the body sits on a critical point (a saddle), where the direction is undefined.
-        let reversed =
-            matches!((direction, self.last_direction), (Some(u), Some(last)) if u.dot(&last) < 0.0);
+        // Only within one field: across a re-solve the two directions are two fields' (measured:
+        // the 8-robot crossing, a robot whose re-solved field went round a neighbour's other
+        // side, smooth along both fields, was counted lost for that one step).
+        let reversed = !o.replanned
+            && matches!((direction, self.last_direction), (Some(u), Some(last)) if u.dot(&last) < 0.0);
         self.last_direction = direction;
         // Only a harmonic field can be flat to working precision (in `W = 1 - V`), measured at
         // the scale of the cells around `p` (deep in a maze `W` and `∇W` are far below f64).
