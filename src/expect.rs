@@ -330,6 +330,7 @@ mod tests {
             lateral_reversals: 3,
             bias_updates: 0,
             resolves: 0,
+            whole_resolves: 0,
             deadlocked: None,
             min_separation: None,
             intractable: None,

@@ -101,6 +101,12 @@ crate::measured! {
         /// Successful re-solves of the harmonic field (sensor readings, replans, lidar map
         /// changes); the first solve is not counted.
         pub resolves: usize [column("resolves")],
+        /// Solves over the whole grid that the re-solves took (a replan may take two): a
+        /// crowd's local replans that fell back to the whole field (cut off in the window, or
+        /// turned back on the last field), fields that take it out of another's way, a lidar's
+        /// map, global replanning; the work that grows with the map and the crowd, where a
+        /// window's does not.
+        pub whole_resolves: usize,
         /// With a lidar: when the map it built closed every route to the target, s; `None`
         /// otherwise.
         pub intractable: Option<f64> [unit("s"), missing("no")],
@@ -171,6 +177,7 @@ pub struct Metrics {
     distance_covered: Option<f64>,
     bias_updates: usize,
     resolves: usize,
+    whole_resolves: usize,
     closest: f64,
     closer_at: f64,
     deadlocked: Option<f64>,
@@ -219,6 +226,7 @@ impl Metrics {
             distance_covered: (distance_at == Some(0.0)).then_some(0.0),
             bias_updates: 0,
             resolves: 0,
+            whole_resolves: 0,
             closest: d0,
             closer_at: 0.0,
             deadlocked: None,
@@ -322,9 +330,10 @@ impl Metrics {
         false
     }
 
-    /// Counts a re-solve of the harmonic field.
-    pub fn record_resolve(&mut self) {
+    /// Counts a re-solve of the harmonic field, which took `whole` solves over the whole grid.
+    pub fn record_resolve(&mut self, whole: usize) {
         self.resolves += 1;
+        self.whole_resolves += whole;
     }
 
     /// Contact starts so far.
@@ -370,6 +379,7 @@ impl Metrics {
             distance_covered: self.distance_covered,
             bias_updates: self.bias_updates,
             resolves: self.resolves,
+            whole_resolves: self.whole_resolves,
             deadlocked: self.deadlocked,
             min_separation: self.min_separation,
             intractable: None,

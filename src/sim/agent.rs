@@ -199,6 +199,8 @@ pub struct Replanned {
     /// The order of way chose it (a yield, or a field past the agents after this one): the
     /// agent may turn about on it, by the rule and not at a critical point of its field.
     by_rule: bool,
+    /// Solves over the whole grid it took (see [`Summary::whole_resolves`]).
+    whole: usize,
     way: Option<Way>,
 }
 
@@ -543,23 +545,28 @@ impl AgentRun {
             return None;
         }
         let local = world.field.replan == Replan::Local;
-        let solve = |others: &[Disc]| match &self.lidar {
-            Some(run) => HarmonicField::solve_known(
-                world,
-                &self.agent,
-                plan.x.into(),
-                &run.map,
-                others,
-                Some(field),
-            ),
-            None => HarmonicField::solve_among(
-                world,
-                &self.agent,
-                plan.x.into(),
-                &self.offsets,
-                others,
-                Some(field),
-            ),
+        // Solves over the whole grid, counted (see `Summary::whole_resolves`).
+        let whole = std::cell::Cell::new(0);
+        let solve = |others: &[Disc]| {
+            whole.set(whole.get() + 1);
+            match &self.lidar {
+                Some(run) => HarmonicField::solve_known(
+                    world,
+                    &self.agent,
+                    plan.x.into(),
+                    &run.map,
+                    others,
+                    Some(field),
+                ),
+                None => HarmonicField::solve_among(
+                    world,
+                    &self.agent,
+                    plan.x.into(),
+                    &self.offsets,
+                    others,
+                    Some(field),
+                ),
+            }
         };
         // The field of the walls: solved again when they were sensed anew, else the one kept,
         // with the last window (whose work the new one may reuse) if the field has one.
@@ -606,6 +613,7 @@ impl AgentRun {
                 walls: new_walls.clone(),
                 yielded,
                 by_rule,
+                whole: whole.get(),
                 way: Some(way),
             })
         };
@@ -648,6 +656,7 @@ impl AgentRun {
             if let Ok(aside) =
                 HarmonicField::yielding(world, &self.agent, plan.x.into(), others, &blocked)
             {
+                whole.set(whole.get() + 1);
                 return Some(done(aside, None, (true, true)));
             }
         }
@@ -907,7 +916,7 @@ impl AgentRun {
                     self.walls = Some(walls);
                 }
                 self.rebuild_failed = false;
-                self.metrics.record_resolve();
+                self.metrics.record_resolve(new.whole);
                 if let Some(run) = &mut self.lidar {
                     run.fields += 1;
                     if run.intractable_at.take().is_some() {
