@@ -641,7 +641,7 @@ impl AgentRun {
         // shrunk there, see `obstacle_discs`), and an agent held in such a gap is held for good
         // unless the neighbours give way (measured: two groups swapping through a door, 4 of 16
         // robots in with the one-cell slack of `stuck`, 16 of 16 with this one).
-        let overrun = (plan.ways.iter()).any(|w| w.runs_into(&me, -ENVELOPE_MARGIN));
+        let overrun = plan.ways.iter().any(|w| w.runs_into(&me, -ENVELOPE_MARGIN));
         // A yielding agent goes on yielding while it stands in the way of an agent before it:
         // were it to take its own field back as soon as no way runs into it, it would step
         // back into the way and be overrun again at the next replan (at a group parked by a
