@@ -646,11 +646,12 @@ impl AgentRun {
         // were it to take its own field back as soon as no way runs into it, it would step
         // back into the way and be overrun again at the next replan (at a group parked by a
         // door, the robots in front of it went back and forth by centimetres for good).
-        let still_in_the_way = self.yielding && plan.ways.iter().any(|w| w.in_the_way(&me));
+        // The ways of the agents before it that it stands in.
+        let blocked: Vec<&Way> = plan.ways.iter().filter(|w| w.in_the_way(&me)).collect();
+        let still_in_the_way = self.yielding && !blocked.is_empty();
         if !stuck && !overrun && !still_in_the_way {
             return Some(first.and_then(|f| done(f, first_way, (false, false))));
         }
-        let blocked: Vec<&Way> = plan.ways.iter().filter(|w| w.in_the_way(&me)).collect();
         if !blocked.is_empty() && self.lidar.is_none() {
             let others = (self.offsets.as_slice(), plan.others.as_slice());
             if let Ok(aside) =
