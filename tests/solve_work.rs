@@ -90,9 +90,7 @@ fn no_shipped_solve_does_more_work_than_saved() {
 /// the robots. A window's solve costs the same in any room; a whole one grows with the room
 /// and, through the nested levels behind a dense crowd, with the crowd (measured: 64 robots on
 /// a 1.8 m circle, 0.13-0.25 s each, 70 % of the run's time), so more of them is a slowdown
-/// however fast the machine. The first 10 s of the 32-robot circle are where a window on the
-/// walls' edge keeps disagreeing with the crowd beyond it (507 whole solves without the
-/// arbiter's reuse, see `ARBITER_REUSE` in `sim/agent.rs`; 174 with it).
+/// however fast the machine.
 #[test]
 fn no_shipped_crowd_replans_more_whole_fields_than_saved() {
     let mut counts = BTreeMap::new();
@@ -100,7 +98,6 @@ fn no_shipped_crowd_replans_more_whole_fields_than_saved() {
         ("crowd.toml", &[][..]),
         ("crowds/circle-16.toml", &[][..]),
         ("crowds/door-16.toml", &["duration=10"][..]),
-        ("crowds/circle-32.toml", &["duration=10"][..]),
     ] {
         let report = nadf::run::run(&world(name, overrides), &Default::default()).unwrap();
         let sum = |f: fn(&nadf::metrics::Summary) -> usize| -> usize {

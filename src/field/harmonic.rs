@@ -187,68 +187,6 @@ impl HarmonicField {
         })
     }
 
-    /// This field (its walls' part) with the field re-solved in a window around `position`,
-    /// the window's edge taken from `whole`: a field of the same grid solved over the whole of
-    /// it with the other agents where they were then (a whole re-solve among them).
-    ///
-    /// The window's cells and their obstacles are this field's walls and the discs `others`
-    /// where they are now; only the edge's values are `whole`'s, so the agents beyond the
-    /// window bend the guidance as they did at that solve, with no coarse window to solve.
-    /// The field returned is `whole` outside the window. `None` when `whole` is of another
-    /// grid.
-    ///
-    /// Why: a window on the field of the walls alone can disagree with the agents beyond it
-    /// (at a crowd, the walls' edge says "straight on" where the whole field goes round),
-    /// and only a whole re-solve settles which way is right. Its answer holds while the crowd
-    /// beyond the window has moved little, so the replans that follow take their edge from it
-    /// instead of asking it again (see `ARBITER_REUSE` in `sim/agent.rs`).
-    ///
-    /// ```
-    /// # let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/room-two-dividers.toml");
-    /// # let world = nadf::world::load(&path, &["field.cell=0.1".parse().unwrap()]).unwrap();
-    /// use nadf::field::{Disc, HarmonicField};
-    /// let agent = &world.agents[0];
-    /// let walls = HarmonicField::solve(&world, agent).unwrap();
-    /// // Another robot a metre down this one's guidance, and the whole field among it.
-    /// let [x, y] = agent.start;
-    /// let g = walls.gradient(agent.start).unwrap();
-    /// let other = Disc { center: [x - g.x / g.norm(), y - g.y / g.norm()], radius: 0.2 };
-    /// let whole = HarmonicField::solve_among(&world, agent, agent.start, &[], &[other], None).unwrap();
-    /// let edged = walls.with_window_edged(&whole, agent, agent.start, &[other], &world.field);
-    /// // Inside the window, as the whole field guides.
-    /// let edged = edged.expect("one grid").unwrap();
-    /// let (a, b) = (whole.gradient(agent.start).unwrap(), edged.gradient(agent.start).unwrap());
-    /// assert!(a.dot(&b) / (a.norm() * b.norm()) > 0.99);
-    /// ```
-    pub fn with_window_edged(
-        &self,
-        whole: &HarmonicField,
-        agent: &Agent,
-        position: [f64; 2],
-        others: &[Disc],
-        settings: &FieldSettings,
-    ) -> Option<Result<Self, FieldError>> {
-        let (grid, edge) = (self.grid(), whole.grid());
-        if (grid.nx, grid.ny, grid.cell, grid.origin) != (edge.nx, edge.ny, edge.cell, edge.origin)
-        {
-            return None;
-        }
-        let values = (grid, self.sampler.reachable_cells(), whole.sampler.values());
-        let window = Window::solve(
-            values,
-            agent,
-            position,
-            // No coarse window: the whole field's edge already holds the agents beyond.
-            (settings.replan_window, settings.replan_window),
-            (others, None),
-            settings.tolerance.max(super::window::WINDOW_TOLERANCE),
-        );
-        Some(window.map(|window| Self {
-            window: Some(Arc::new(window)),
-            ..whole.clone()
-        }))
-    }
-
     /// This field without its window: the field of the walls alone.
     pub fn without_window(&self) -> Self {
         Self {

@@ -35,14 +35,6 @@ use crate::field::{
 use crate::metrics::{Metrics, Summary};
 use crate::world::{Agent, ControllerKind, GuidanceKind, Replan, SensorKind, WallShape, World};
 
-/// How many replans after a whole re-solve among the others settled which way the agent goes
-/// (see [`AgentRun::resolve`]) its windows take their edge from that field rather than from
-/// the field of the walls: the crowd beyond the window moves little in that time (0.4 s at
-/// 10 Hz), and a window on the walls' edge would only disagree with it again and ask for
-/// another whole re-solve, each costing a hundred windows behind a dense crowd (measured on
-/// 64 robots on the 1.8 m circle: 317 whole re-solves in 8 s, 102 ms each, 58 % of the time).
-pub const ARBITER_REUSE: u32 = 4;
-
 /// One agent in a running simulation.
 pub struct AgentRun {
     /// The agent as the world file describes it.
@@ -99,9 +91,6 @@ pub struct AgentRun {
     way: Option<Way>,
     /// Whether its field is one that takes it out of another's way.
     yielding: bool,
-    /// The last whole re-solve among the others that settled which way it goes, and the
-    /// replans it has served since (see [`ARBITER_REUSE`]).
-    arbiter: Option<(HarmonicField, u32)>,
     /// Whether it has come within its band of the target (once is enough: from then on it
     /// gives way to every agent that has not).
     arrived: bool,
@@ -212,9 +201,6 @@ pub struct Replanned {
     by_rule: bool,
     /// Solves over the whole grid it took (see [`Summary::whole_resolves`]).
     whole: usize,
-    /// It is a whole re-solve among all the others that settled which way the agent goes:
-    /// the next windows take their edge from it (see [`ARBITER_REUSE`]).
-    arbiter: bool,
     way: Option<Way>,
 }
 
@@ -353,7 +339,6 @@ impl AgentRun {
             command: None,
             way: None,
             yielding: false,
-            arbiter: None,
             arrived: false,
         }
     }
@@ -599,40 +584,23 @@ impl AgentRun {
                 Err(e) => return Some(Err(e)),
             },
         };
-        // The last whole field among all the others, while it serves (its walls still the
-        // walls): the windows among all of them take their edge from it.
-        let arbiter = (self.arbiter.as_ref())
-            .filter(|(_, served)| *served < ARBITER_REUSE && !plan.walls_changed)
-            .map(|(whole, _)| whole);
-        // Whether the field among all the others is a whole re-solve that settled the way.
-        let arbitrated = std::cell::Cell::new(false);
-        // The field among the discs `others`: in a window on the field of the walls (its edge
-        // from the arbiter when they are all the others), or the whole field when the window
-        // is cut off or its way on is blocked in it (whether a detour exists beyond the
-        // window, and which, only the whole field can say).
+        // The field among the discs `others`: in a window on the field of the walls, or the
+        // whole field when the window is cut off or its way on is blocked in it (whether a
+        // detour exists beyond the window, and which, only the whole field can say).
         let among = |others: &[Disc]| {
-            let all = others.len() == plan.others.len();
-            let settle = || {
-                arbitrated.set(all);
-                solve(others)
-            };
             if !local {
                 solve(others)
             } else if others.is_empty() {
                 Ok(walls.without_window())
             } else {
-                let (agent, x) = (&self.agent, plan.x.into());
-                let edged = arbiter.filter(|_| all).and_then(|whole| {
-                    walls.with_window_edged(whole, agent, x, others, &world.field)
-                });
-                match edged.unwrap_or_else(|| walls.with_window(agent, x, others, &world.field)) {
-                    Err(FieldError::Unreachable { .. }) => settle(),
+                match walls.with_window(&self.agent, plan.x.into(), others, &world.field) {
+                    Err(FieldError::Unreachable { .. }) => solve(others),
                     // A window whose guidance at the agent turns back on the last field's:
                     // the window moved with the agent and the field of the walls on its edge
                     // disagrees with the others beyond it (at a crowd parked by a door, the
                     // agent turns back and forth between two windows for good). Which way is
                     // right only the whole field can say.
-                    Ok(window) if turns_back(field, &window, plan.x) => settle(),
+                    Ok(window) if turns_back(field, &window, plan.x) => solve(others),
                     result => result,
                 }
             }
@@ -646,7 +614,6 @@ impl AgentRun {
                 yielded,
                 by_rule,
                 whole: whole.get(),
-                arbiter: arbitrated.get() && !by_rule,
                 way: Some(way),
             })
         };
@@ -946,11 +913,6 @@ impl AgentRun {
                 self.log.replanned = true;
                 self.yielding = new.yielded;
                 self.way = new.way;
-                self.arbiter = match self.arbiter.take() {
-                    _ if new.arbiter => Some((field.clone(), 0)),
-                    Some((whole, served)) if served < ARBITER_REUSE => Some((whole, served + 1)),
-                    _ => None,
-                };
                 if let Some(walls) = new.walls {
                     self.walls = Some(walls);
                 }
