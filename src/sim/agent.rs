@@ -646,8 +646,13 @@ impl AgentRun {
         // were it to take its own field back as soon as no way runs into it, it would step
         // back into the way and be overrun again at the next replan (at a group parked by a
         // door, the robots in front of it went back and forth by centimetres for good).
-        // The ways of the agents before it that it stands in.
-        let blocked: Vec<&Way> = plan.ways.iter().filter(|w| w.in_the_way(&me)).collect();
+        // The ways of the agents before it that it stands in: only looked for when they can
+        // matter (every agent's replan passes here; most are neither yielding nor stuck).
+        let blocked: Vec<&Way> = if self.yielding || stuck || overrun {
+            plan.ways.iter().filter(|w| w.in_the_way(&me)).collect()
+        } else {
+            Vec::new()
+        };
         let still_in_the_way = self.yielding && !blocked.is_empty();
         if !stuck && !overrun && !still_in_the_way {
             return Some(first.and_then(|f| done(f, first_way, (false, false))));
