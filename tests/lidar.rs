@@ -151,3 +151,55 @@ fn bad_lidar_settings_are_located_errors() {
     .to_string();
     assert!(e.contains("only a lidar has `range`"), "{e}");
 }
+
+/// A lidar agent driven by a commanded force (a policy's, from Python) does not re-solve its
+/// field at each change of its map: the change is solved for when the law's force is asked
+/// for, or at the first step after control comes back. The law's force after the one put-off
+/// solve is the one it is after solving at every change (to the solver's tolerance).
+#[test]
+fn a_commanded_lidar_agent_solves_its_field_only_when_it_is_read() {
+    let world = common::world("unknown-room.toml", &["duration=3"]);
+    let fields = |sim: &Simulation| sim.agents[0].lidar.as_ref().unwrap().fields;
+    let seen = |sim: &Simulation| sim.agents[0].lidar.as_ref().unwrap().map.seen().to_vec();
+    let mut eager = Simulation::new(&world).unwrap();
+    let mut lazy = Simulation::new(&world).unwrap();
+    // Towards the target at a quarter of the law's first force, held for 1.5 s.
+    let force = eager.law_force(0).unwrap() * 0.25;
+    for sim in [&mut eager, &mut lazy] {
+        assert!(sim.agents[0].command(Some(force)));
+    }
+    let first = fields(&lazy);
+    for _ in 0..150 {
+        eager.step();
+        lazy.step();
+        eager.law_force(0).unwrap();
+    }
+    assert_eq!(seen(&eager), seen(&lazy), "the same scans");
+    assert_ne!(seen(&lazy), {
+        let fresh = Simulation::new(&world).unwrap();
+        seen(&fresh)
+    });
+    assert!(fields(&eager) > first + 3, "{} fields", fields(&eager));
+    assert_eq!(
+        fields(&lazy),
+        first,
+        "nothing solved while commanded and unread"
+    );
+    let (a, b) = (eager.law_force(0).unwrap(), lazy.law_force(0).unwrap());
+    assert_eq!(
+        fields(&lazy),
+        first + 1,
+        "one solve for every change put off"
+    );
+    assert!((a - b).norm() < 1e-6 * a.norm(), "{a} vs {b}");
+    // Control back: the first step solves for what was put off since.
+    let mut back = Simulation::new(&world).unwrap();
+    assert!(back.agents[0].command(Some(force)));
+    for _ in 0..150 {
+        back.step();
+    }
+    assert_eq!(fields(&back), first);
+    assert!(back.agents[0].command(None));
+    back.step();
+    assert_eq!(fields(&back), first + 1);
+}

@@ -105,7 +105,9 @@ class Simulation:
     def command(self, agent: int, force: Optional[Sequence[float]]) -> None:
         """Applies ``force`` (N, ``[fx, fy]``) to agent ``agent`` from the next step on instead of
         its control law's, until ``None`` gives control back. The law still runs (its bias or
-        clamp moves on); the clearance envelope, when on, still keeps the body off the walls;
+        clamp moves on), but a lidar agent's field is re-solved for the walls it sees only
+        when it is read (the law's force, the field's arrays) or control comes back; the
+        clearance envelope, when on, still keeps the body off the walls;
         the speed limit and ``max_force`` do not apply. Raises ``ValueError`` for a force that
         is not finite."""
         self._sim.command(agent, None if force is None else [float(f) for f in force])

@@ -110,12 +110,6 @@ class Episodes:
         return self.current
 
 
-def rotation(theta: float) -> np.ndarray:
-    """The rotation by ``theta`` (rad): body-frame vectors to the world frame."""
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, -s], [s, c]])
-
-
 class Controlled:
     """One agent of a simulation under a policy: its spaces, its observation, its reward.
 
@@ -139,6 +133,7 @@ class Controlled:
         self.name = world.agents[index]
         target, self.radius, self.mass, max_force, self.band, lidar = sim.agent_info(index)
         self.target = np.array(target)
+        self._target = (float(target[0]), float(target[1]))
         self.force_limit = float(max_force if max_force is not None else force_limit)
         if not (self.force_limit > 0.0 and math.isfinite(self.force_limit)):
             raise ValueError(f"agent {self.name!r}: force limit {self.force_limit} N")
@@ -166,6 +161,7 @@ class Controlled:
         self.frame = 0.0
         self.position = self.target
         self.velocity = np.zeros(2)
+        self.speed = 0.0
         self.contacts = 0
         self.distance = math.inf
         self.observe()
@@ -178,43 +174,52 @@ class Controlled:
         self.frame = frame
         self.position = np.array(position)
         self.velocity = np.array(velocity)
+        self.speed = math.hypot(*velocity)
         self.new_contacts = contacts - self.contacts
         self.contacts = contacts
-        self.distance = float(np.linalg.norm(self.target - self.position))
-        to_body = rotation(frame).T
+        # Two-vectors in plain floats: NumPy's per-call cost is most of a step's here.
+        goal = (self._target[0] - position[0], self._target[1] - position[1])
+        self.distance = math.hypot(*goal)
+        c, s = math.cos(frame), math.sin(frame)
+        to_body = lambda x, y: (c * x + s * y, c * y - s * x)  # noqa: E731  (R(θ)ᵀ)
         obs = {
-            "goal": (to_body @ (self.target - self.position)).astype(np.float32),
-            "velocity": (to_body @ self.velocity).astype(np.float32),
+            "goal": np.array(to_body(*goal), np.float32),
+            "velocity": np.array(to_body(*velocity), np.float32),
         }
         if self.lidar is not None:
             rays, range_ = self.lidar
             scan = np.frombuffer(ranges, dtype="<f4")
             obs["lidar"] = scan.copy() if scan.size else np.full(rays, range_, np.float32)
         else:
-            g = np.zeros(2) if guidance is None else to_body @ np.array(guidance)
-            obs["guidance"] = g.astype(np.float32)
+            g = (0.0, 0.0) if guidance is None else to_body(*guidance)
+            obs["guidance"] = np.array(g, np.float32)
         return obs
 
     def force(self, action: Sequence[float]) -> List[float]:
         """The world-frame force, N, of ``action`` (clipped to ``[-1, 1]``)."""
-        a = np.clip(np.asarray(action, dtype=np.float64).reshape(2), -1.0, 1.0)
-        if not np.all(np.isfinite(a)):
+        x, y = np.asarray(action, dtype=np.float64).reshape(2).tolist()
+        if not (math.isfinite(x) and math.isfinite(y)):
             raise ValueError(f"agent {self.name!r}: an action must be finite, got {action!r}")
-        return list(rotation(self.frame) @ (a * self.force_limit))
+        x = min(max(x, -1.0), 1.0) * self.force_limit
+        y = min(max(y, -1.0), 1.0) * self.force_limit
+        c, s = math.cos(self.frame), math.sin(self.frame)
+        return [c * x - s * y, s * x + c * y]
 
     def expert_action(self) -> np.ndarray:
         """The action of the agent's own law in the state it is in now: its force for the next
-        step (computed without changing anything), in the body frame, over the force limit,
+        step (computed without changing the run; a lidar agent's field is first solved for
+        the walls seen since it was last solved), in the body frame, over the force limit,
         clipped to ``[-1, 1]``. For a world without replanning or a lidar this is the force
         the law applies, so the expert driven through the environment reproduces the law's
         run (to the actions' float32 rounding)."""
-        force = rotation(self.frame).T @ np.array(self.sim.law_force(self.index))
-        return np.clip(force / self.force_limit, -1.0, 1.0).astype(np.float32)
+        x, y = self.sim.law_force(self.index)
+        c, s = math.cos(self.frame), math.sin(self.frame)
+        body = ((c * x + s * y) / self.force_limit, (c * y - s * x) / self.force_limit)
+        return np.array([min(max(f, -1.0), 1.0) for f in body], np.float32)
 
     def arrived(self) -> bool:
         """Whether it is within its settling band, at most ``arrival_speed`` fast."""
-        speed = float(np.linalg.norm(self.velocity))
-        return self.distance <= self.band and speed <= self.arrival_speed
+        return self.distance <= self.band and self.speed <= self.arrival_speed
 
     def reward(self, before: float) -> float:
         """The progress towards the target since the distance was ``before`` (m), minus the

@@ -395,12 +395,13 @@ impl Simulation {
         agent: usize,
     ) -> PyResult<([Bound<'py, PyBytes>; 4], [f64; 2], f64)> {
         self.with(|r| {
-            let run = r.sim.agents.get(agent).ok_or_else(|| {
-                PyIndexError::new_err(format!(
-                    "agent {agent}: the world has {} agent(s)",
-                    r.sim.agents.len()
-                ))
+            let agents = r.sim.agents.len();
+            let (world, run) = (&r.sim.world, r.sim.agents.get_mut(agent));
+            let run = run.ok_or_else(|| {
+                PyIndexError::new_err(format!("agent {agent}: the world has {agents} agent(s)"))
             })?;
+            // A commanded lidar agent's field as the law would read it now.
+            run.bring_up_to_date(world);
             let field = run.field.harmonic().ok_or_else(|| {
                 PyValueError::new_err(format!(
                     "agent `{}` has no harmonic field (an attractive-repulsive potential has no grid)",
@@ -498,13 +499,16 @@ impl Simulation {
     }
 
     /// The force agent `agent`'s law would apply in the next step from the state it is in
-    /// now, N, computed without changing anything (`Simulation::law_force`): the expert's
+    /// now, N, computed without changing the run (`Simulation::law_force`): the expert's
     /// action. The field is the current one (a replan or a scan due in the next step is not
-    /// anticipated).
-    fn law_force(&self, agent: usize) -> PyResult<[f64; 2]> {
-        self.with(|r| {
-            agent_of(&r.sim, agent)?;
-            Ok(r.sim.law_force(agent).map_or([0.0; 2], Into::into))
+    /// anticipated); for a commanded lidar agent, the walls it has seen since its field was
+    /// last solved are solved for first (with the GIL released).
+    fn law_force(&self, py: Python<'_>, agent: usize) -> PyResult<[f64; 2]> {
+        py.detach(|| {
+            self.with(|r| {
+                agent_of(&r.sim, agent)?;
+                Ok(r.sim.law_force(agent).map_or([0.0; 2], Into::into))
+            })
         })
     }
 }

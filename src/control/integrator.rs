@@ -232,6 +232,16 @@ impl<const N: usize> Integrator<N> {
     pub fn applied(&mut self, input: &ControlInput<N>, force: &SVector<f64, N>) {
         self.last = Some((input.velocity, *force));
     }
+
+    /// Corrects the force recorded for this step by [`Integrator::applied`] to `force`, N,
+    /// when something other than the law decided what the body got (a force commanded from
+    /// outside): counted as the law's, the difference would be taken for an external force
+    /// and fought in the next step.
+    pub fn applied_instead(&mut self, force: &SVector<f64, N>) {
+        if let Some((_, last)) = &mut self.last {
+            *last = *force;
+        }
+    }
 }
 
 #[cfg(test)]
@@ -406,5 +416,20 @@ mod tests {
         // A free step at −3 + 0.01·(1 + 2) m/s: the external force is 2 N.
         integrator.observe(&input(0.0, -2.97, 0.01));
         assert!((integrator.external().x - 2.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_force_applied_instead_of_the_laws_is_not_taken_for_an_external_force() {
+        let mut integrator = Integrator::<1>::new(2.0);
+        let first = input(0.0, 0.0, 0.01);
+        // The law asked for 5 N; a policy's 1 N went to the body, with no external force.
+        integrator.applied(&first, &Vector1::new(5.0));
+        integrator.applied_instead(&Vector1::new(1.0));
+        integrator.observe(&input(0.0, 0.005, 0.01));
+        assert!(
+            integrator.external().x.abs() < 1e-12,
+            "{}",
+            integrator.external()
+        );
     }
 }

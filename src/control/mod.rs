@@ -161,6 +161,14 @@ impl<const N: usize> Controller<N> {
         }
     }
 
+    /// The body got `force`, N, in the step [`Controller::step`] just computed, instead of the
+    /// law's (see [`Integrator::applied_instead`]).
+    pub fn applied_instead(&mut self, force: &SVector<f64, N>) {
+        if let Some(integrator) = &mut self.integrator {
+            integrator.applied_instead(force);
+        }
+    }
+
     /// The force [`Controller::step`] would return for `input`, without changing anything:
     /// the integrator's estimate of the external force and the bias's settling detector stay
     /// as they are (`bias_updated` is `false`). What a policy learning against the law asks

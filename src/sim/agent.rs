@@ -86,6 +86,9 @@ pub struct AgentRun {
     log: StepLog,
     /// A force commanded from outside (see [`AgentRun::command`]), N.
     command: Option<Vector2<f64>>,
+    /// The plan of the last step whose re-solve for the lidar's new walls was put off while
+    /// the body was commanded (see [`AgentRun::bring_up_to_date`]).
+    put_off: Option<Plan>,
     /// Its way: the next metres of its guidance at the last replan, which the agents after it
     /// give way to (see `field/yielding.rs`).
     way: Option<Way>,
@@ -161,6 +164,7 @@ struct StepLog {
 }
 
 /// An agent's part of a step, read before any field is re-solved.
+#[derive(Clone)]
 pub struct Plan {
     /// Position at the start of the step.
     x: Vector2<f64>,
@@ -337,6 +341,7 @@ impl AgentRun {
             external: Vector2::from(world.external_acceleration),
             log: StepLog::default(),
             command: None,
+            put_off: None,
             way: None,
             yielding: false,
             arrived: false,
@@ -360,7 +365,10 @@ impl AgentRun {
     /// law's (which still runs, so that its own state moves on), until `None` gives control
     /// back: a policy other than the law drives the body (from Python, say). The clearance
     /// envelope, when on, still keeps the commanded body from touching a wall, and the speed
-    /// limit does not apply. A force that is not finite is refused (`false`), as is any force
+    /// limit does not apply. While commanded, a lidar agent's field is not re-solved at each
+    /// change of its map (the law runs on the field it has): the change is solved for when
+    /// the field is read ([`AgentRun::bring_up_to_date`]: the law's force, the field's
+    /// arrays), at the next replan among others, or when control comes back. A force that is not finite is refused (`false`), as is any force
     /// for a robot on wheels under the unicycle law, which commands its wheels itself.
     pub fn command(&mut self, force: Option<Vector2<f64>>) -> bool {
         let unicycle = self.agent.controller.kind == ControllerKind::Unicycle;
@@ -501,7 +509,9 @@ impl AgentRun {
                 })
                 .collect();
         }
-        plan.walls_changed = plan.sensed_now || map_changed;
+        // A re-solve put off while commanded is due with this one, or now control is back.
+        let put_off = self.put_off.take().is_some();
+        plan.walls_changed = plan.sensed_now || map_changed || put_off;
         plan.rebuild = plan.walls_changed || replan_due;
         if plan.rebuild && index < crowd.len() {
             // Agent k is `others[k]` before this one and `others[k - 1]` after it.
@@ -516,7 +526,26 @@ impl AgentRun {
                 .map(|k| if k < index { k } else { k - 1 })
                 .collect();
         }
+        if plan.rebuild && !replan_due && !plan.sensed_now && self.command.is_some() {
+            // Commanded, the body goes where the policy sends it whatever its field: the
+            // lidar's new walls are solved for when the law's force is asked for or control
+            // comes back (a policy trained on the scans alone never pays for a field).
+            self.put_off = Some(plan.clone());
+            plan.rebuild = false;
+            plan.walls_changed = false;
+        }
         plan
+    }
+
+    /// Re-solves its field for the lidar's walls seen while it was commanded, if that was
+    /// put off (see [`AgentRun::command`]): the field of the last step's plan, the one that
+    /// step would have solved, so the law's force ([`AgentRun::law_force`]) and the field read
+    /// now are what they would be had nothing been put off.
+    pub fn bring_up_to_date(&mut self, world: &World) {
+        if let Some(plan) = self.put_off.take() {
+            let solved = self.resolve(&plan, world);
+            self.update_field(plan, solved);
+        }
     }
 
     /// Step 2: the harmonic field re-solved for `plan`, if it is due (warm-started from the
@@ -729,8 +758,10 @@ impl AgentRun {
         let mut force = self.log.control.map_or(Vector2::zeros(), |c| c.force);
         if let Some(commanded) = self.command.filter(|_| !self.frozen) {
             // Commanded from outside: the law ran (its state, a bias or a clamp, moves on as
-            // if it were in control) but this force goes to the body instead.
+            // if it were in control) but this force goes to the body instead, and the law's
+            // estimate of the external force knows it.
             force = commanded;
+            self.controller.applied_instead(&commanded);
             if let Some(control) = &mut self.log.control {
                 control.force = commanded;
             }

@@ -267,11 +267,13 @@ impl Simulation {
     }
 
     /// The force agent `agent`'s control law would apply in the next step from the state it is
-    /// in now, N, without changing anything (see [`AgentRun::law_force`]): the expert's
-    /// action for a policy that drives the body instead of its law ([`AgentRun::command`]).
-    /// `None` for an agent the world does not have.
-    pub fn law_force(&self, agent: usize) -> Option<Vector2<f64>> {
-        let run = self.agents.get(agent)?;
+    /// in now, N, changing nothing but a re-solve put off while it was commanded (see
+    /// [`AgentRun::law_force`], [`AgentRun::bring_up_to_date`]): the expert's action for a
+    /// policy that drives the body instead of its law ([`AgentRun::command`]). `None` for an
+    /// agent the world does not have.
+    pub fn law_force(&mut self, agent: usize) -> Option<Vector2<f64>> {
+        self.agents.get_mut(agent)?.bring_up_to_date(&self.world);
+        let run = &self.agents[agent];
         // Only ORCA's law reads the neighbours (the others see them in their field).
         let others = if run.orca.is_some() {
             let bodies: Vec<Neighbour> =
