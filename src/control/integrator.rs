@@ -235,8 +235,8 @@ impl<const N: usize> Integrator<N> {
 
     /// Corrects the force recorded for this step by [`Integrator::applied`] to `force`, N,
     /// when something other than the law decided what the body got (a force commanded from
-    /// outside): counted as the law's, the difference would be taken for an external force
-    /// and fought in the next step.
+    /// outside, the clearance envelope's): counted as the law's, the difference would be taken
+    /// for an external force and fought in the next step.
     pub fn applied_instead(&mut self, force: &SVector<f64, N>) {
         if let Some((_, last)) = &mut self.last {
             *last = *force;

@@ -758,10 +758,8 @@ impl AgentRun {
         let mut force = self.log.control.map_or(Vector2::zeros(), |c| c.force);
         if let Some(commanded) = self.command.filter(|_| !self.frozen) {
             // Commanded from outside: the law ran (its state, a bias or a clamp, moves on as
-            // if it were in control) but this force goes to the body instead, and the law's
-            // estimate of the external force knows it.
+            // if it were in control) but this force goes to the body instead.
             force = commanded;
-            self.controller.applied_instead(&commanded);
             if let Some(control) = &mut self.log.control {
                 control.force = commanded;
             }
@@ -798,6 +796,12 @@ impl AgentRun {
                 } else {
                     let next = v + (force / self.agent.mass + self.external) * dt;
                     sweeps[index] = self.bare_sweep(x, step.moved(x, v, next));
+                }
+                if !self.frozen {
+                    // What the body gets (a command, the envelope's force, the stop of an
+                    // intractable task) is what the law's estimate of the external force
+                    // must subtract: the difference to the law's own is no external force.
+                    self.controller.applied_instead(&force);
                 }
                 self.log.wheels = self.body.actuate(physics, &force);
             }
