@@ -368,8 +368,9 @@ impl AgentRun {
     /// limit does not apply. While commanded, a lidar agent's field is not re-solved at each
     /// change of its map (the law runs on the field it has): the change is solved for when
     /// the field is read ([`AgentRun::bring_up_to_date`]: the law's force, the field's
-    /// arrays), at the next replan among others, or when control comes back. A force that is not finite is refused (`false`), as is any force
-    /// for a robot on wheels under the unicycle law, which commands its wheels itself.
+    /// arrays), at the next replan among others, or when control comes back. A force that is
+    /// not finite is refused (`false`), as is any force for a robot on wheels under the
+    /// unicycle law, which commands its wheels itself.
     pub fn command(&mut self, force: Option<Vector2<f64>>) -> bool {
         let unicycle = self.agent.controller.kind == ControllerKind::Unicycle;
         if force.is_some_and(|f| !f.iter().all(|c| c.is_finite()) || unicycle) {
