@@ -110,6 +110,25 @@ class Episodes:
         return self.current
 
 
+def to_body(theta: float, x: float, y: float) -> Tuple[float, float]:
+    """The world-frame vector ``(x, y)`` in a body frame turned by ``theta`` (rad): ``R(θ)ᵀ``.
+    (Two-vectors in plain floats: NumPy's per-call cost was most of an environment step.)"""
+    c, s = math.cos(theta), math.sin(theta)
+    return (c * x + s * y, c * y - s * x)
+
+
+def to_world(theta: float, x: float, y: float) -> Tuple[float, float]:
+    """The body-frame vector ``(x, y)`` in the world frame, the body turned by ``theta``
+    (rad): ``R(θ)``."""
+    c, s = math.cos(theta), math.sin(theta)
+    return (c * x - s * y, s * x + c * y)
+
+
+def unit_clip(v: float) -> float:
+    """``v`` clipped to ``[-1, 1]``."""
+    return min(max(v, -1.0), 1.0)
+
+
 class Controlled:
     """One agent of a simulation under a policy: its spaces, its observation, its reward.
 
@@ -133,6 +152,7 @@ class Controlled:
         self.name = world.agents[index]
         target, self.radius, self.mass, max_force, self.band, lidar = sim.agent_info(index)
         self.target = np.array(target)
+        # The same in plain floats, for the observation's arithmetic.
         self._target = (float(target[0]), float(target[1]))
         self.force_limit = float(max_force if max_force is not None else force_limit)
         if not (self.force_limit > 0.0 and math.isfinite(self.force_limit)):
@@ -177,21 +197,18 @@ class Controlled:
         self.speed = math.hypot(*velocity)
         self.new_contacts = contacts - self.contacts
         self.contacts = contacts
-        # Two-vectors in plain floats: NumPy's per-call cost is most of a step's here.
         goal = (self._target[0] - position[0], self._target[1] - position[1])
         self.distance = math.hypot(*goal)
-        c, s = math.cos(frame), math.sin(frame)
-        to_body = lambda x, y: (c * x + s * y, c * y - s * x)  # noqa: E731  (R(θ)ᵀ)
         obs = {
-            "goal": np.array(to_body(*goal), np.float32),
-            "velocity": np.array(to_body(*velocity), np.float32),
+            "goal": np.array(to_body(frame, *goal), np.float32),
+            "velocity": np.array(to_body(frame, *velocity), np.float32),
         }
         if self.lidar is not None:
             rays, range_ = self.lidar
             scan = np.frombuffer(ranges, dtype="<f4")
             obs["lidar"] = scan.copy() if scan.size else np.full(rays, range_, np.float32)
         else:
-            g = (0.0, 0.0) if guidance is None else to_body(*guidance)
+            g = (0.0, 0.0) if guidance is None else to_body(frame, *guidance)
             obs["guidance"] = np.array(g, np.float32)
         return obs
 
@@ -200,10 +217,8 @@ class Controlled:
         x, y = np.asarray(action, dtype=np.float64).reshape(2).tolist()
         if not (math.isfinite(x) and math.isfinite(y)):
             raise ValueError(f"agent {self.name!r}: an action must be finite, got {action!r}")
-        x = min(max(x, -1.0), 1.0) * self.force_limit
-        y = min(max(y, -1.0), 1.0) * self.force_limit
-        c, s = math.cos(self.frame), math.sin(self.frame)
-        return [c * x - s * y, s * x + c * y]
+        limit = self.force_limit
+        return list(to_world(self.frame, unit_clip(x) * limit, unit_clip(y) * limit))
 
     def expert_action(self) -> np.ndarray:
         """The action of the agent's own law in the state it is in now: its force for the next
@@ -212,10 +227,9 @@ class Controlled:
         clipped to ``[-1, 1]``. For a world without replanning or a lidar this is the force
         the law applies, so the expert driven through the environment reproduces the law's
         run (to the actions' float32 rounding)."""
-        x, y = self.sim.law_force(self.index)
-        c, s = math.cos(self.frame), math.sin(self.frame)
-        body = ((c * x + s * y) / self.force_limit, (c * y - s * x) / self.force_limit)
-        return np.array([min(max(f, -1.0), 1.0) for f in body], np.float32)
+        x, y = to_body(self.frame, *self.sim.law_force(self.index))
+        limit = self.force_limit
+        return np.array([unit_clip(x / limit), unit_clip(y / limit)], np.float32)
 
     def arrived(self) -> bool:
         """Whether it is within its settling band, at most ``arrival_speed`` fast."""
