@@ -309,9 +309,7 @@ impl Simulation {
     fn command(&self, agent: usize, force: Option<[f64; 2]>) -> PyResult<()> {
         self.with(|r| {
             let count = r.sim.agents.len();
-            let run = r.sim.agents.get_mut(agent).ok_or_else(|| {
-                PyIndexError::new_err(format!("agent {agent}: the world has {count} agent(s)"))
-            })?;
+            let run = (r.sim.agents.get_mut(agent)).ok_or_else(|| no_such_agent(agent, count))?;
             if run.command(force.map(nalgebra::Vector2::from)) {
                 Ok(())
             } else {
@@ -395,11 +393,9 @@ impl Simulation {
         agent: usize,
     ) -> PyResult<([Bound<'py, PyBytes>; 4], [f64; 2], f64)> {
         self.with(|r| {
-            let agents = r.sim.agents.len();
+            let count = r.sim.agents.len();
             let (world, run) = (&r.sim.world, r.sim.agents.get_mut(agent));
-            let run = run.ok_or_else(|| {
-                PyIndexError::new_err(format!("agent {agent}: the world has {agents} agent(s)"))
-            })?;
+            let run = run.ok_or_else(|| no_such_agent(agent, count))?;
             // A commanded lidar agent's field as the law would read it now.
             run.bring_up_to_date(world);
             let field = run.field.harmonic().ok_or_else(|| {
@@ -523,12 +519,12 @@ fn motion(run: &AgentRun, state: Option<&AgentState>) -> ([f64; 2], [f64; 2]) {
 
 /// Agent `agent` of `sim`, or an `IndexError` naming how many there are.
 fn agent_of(sim: &nadf::sim::Simulation, agent: usize) -> PyResult<&AgentRun> {
-    sim.agents.get(agent).ok_or_else(|| {
-        PyIndexError::new_err(format!(
-            "agent {agent}: the world has {} agent(s)",
-            sim.agents.len()
-        ))
-    })
+    (sim.agents.get(agent)).ok_or_else(|| no_such_agent(agent, sim.agents.len()))
+}
+
+/// The `IndexError` for agent `agent` of a simulation of `count` agents.
+fn no_such_agent(agent: usize, count: usize) -> PyErr {
+    PyIndexError::new_err(format!("agent {agent}: the world has {count} agent(s)"))
 }
 
 /// Runs shard `index` of `count` of the experiment file at `path` (with the overrides `set`)
