@@ -3,7 +3,10 @@
 
 Writes crowd worlds, runs each with `nadf run --no-record --json` and prints one table row per
 world: robots reached, contacts (walls and agents), the closest approach between two robots,
-deadlocked robots, the last settling time, and the wall time against the simulated time.
+the robots flagged deadlocked (parked with a neighbour next to them) and livelocked (moving but
+getting nowhere) at some time, the robots that did not reach by what they were flagged
+(deadlocked / livelocked only / neither: a robot in the last column ran out of time while
+still making progress), the last settling time, and the wall time against the simulated time.
 
     python3 scripts/crowds.py --nadf target/release/nadf --robots 16 32 --arc 2.5 1.8 1.2 \
         --seeds 0 1 2 --controller nadf orca --kinds circle crossing door
@@ -149,7 +152,7 @@ def main():
     global BARE
     BARE = args.bare
     extra = [a for s in args.set for a in ("--set", s)]
-    print("world                      ctrl  robots reached contacts closest_m deadlocked  last_settle_s  wall/sim")
+    print("world                      ctrl  robots reached contacts closest_m deadlocked livelocked unreached_d/l/-  last_settle_s  wall/sim")
     for kind in args.kinds:
         for n in args.robots:
             for arc in args.arc:
@@ -166,10 +169,15 @@ def main():
                             default=float("inf"),
                         )
                         deadlocked = sum(a["deadlocked"] is not None for a in agents)
+                        livelocked = sum(a["livelocked"] is not None for a in agents)
+                        short = [a for a in agents if not a["reached"]]
+                        dead = sum(a["deadlocked"] is not None for a in short)
+                        live = sum(a["deadlocked"] is None and a["livelocked"] is not None for a in short)
+                        why = f"{dead}/{live}/{len(short) - dead - live}"
                         settle = max((a["settling_time"] or float("nan") for a in agents), default=0)
                         print(
                             f"{kind}-{n}-{arc}-s{seed:<10} {ctrl:5} {len(agents):6} {reached:7} {contacts:8} "
-                            f"{closest:9.4f} {deadlocked:10} {settle:14.2f} {wall / duration:9.3f}",
+                            f"{closest:9.4f} {deadlocked:10} {livelocked:10} {why:>15} {settle:14.2f} {wall / duration:9.3f}",
                             flush=True,
                         )
 

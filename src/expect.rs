@@ -332,6 +332,7 @@ mod tests {
             resolves: 0,
             whole_resolves: 0,
             deadlocked: None,
+            livelocked: None,
             min_separation: None,
             intractable: None,
             map_seen: None,

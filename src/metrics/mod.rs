@@ -39,6 +39,31 @@ pub const PROGRESS: f64 = 0.05;
 /// How long without progress makes a blocked agent deadlocked, s.
 pub const DEADLOCK_AFTER: f64 = 5.0;
 
+/// An agent among others that has not come [`PROGRESS`] closer to its target for this long (s)
+/// while it kept moving all the while, at least [`LIVELOCK_PATH`] of path in each third of it,
+/// is livelocked: it goes round or back and forth instead of on. (A deadlock is the parked
+/// case; a crowd milling about, each robot dodging the others, is this one, and neither
+/// contacts nor `deadlocked` show it.) Three times [`DEADLOCK_AFTER`], so that a detour around
+/// a jam, which gains no ground for a while, is not taken for one. Progress is counted in a
+/// straight line to the target, as for a deadlock, so a detour that leads away from it for
+/// longer than this is reported too: a flag to look at, not a fault.
+pub const LIVELOCK_AFTER: f64 = 15.0;
+
+/// The path (m) a livelocked agent covers in each third of [`LIVELOCK_AFTER`]: more than a
+/// body length of shuffling. A robot driven back out of a corridor by another and parked there
+/// moved, but not all the while, and is no livelock (`corridor-jam`).
+pub const LIVELOCK_PATH: f64 = 1.0;
+
+/// What [`Metrics::watch_progress`] found in a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stall {
+    /// No progress for [`DEADLOCK_AFTER`] with another agent next to it.
+    Deadlocked,
+    /// No progress for [`LIVELOCK_AFTER`] while it kept moving ([`LIVELOCK_PATH`] in each
+    /// third of it).
+    Livelocked,
+}
+
 /// A reversal of the sideways motion counts only between excursions faster than this, m/s, so
 /// that the jitter of a body moving straight is not counted as oscillation.
 pub const LATERAL_REVERSAL_SPEED: f64 = 0.05;
@@ -95,6 +120,11 @@ crate::measured! {
         /// target for [`DEADLOCK_AFTER`] seconds, outside the settling band, with another agent
         /// within its own diameter of it; `None` otherwise.
         pub deadlocked: Option<f64> [unit("s"), missing("no")],
+        /// When the agent was found livelocked, s: among other agents, no progress of
+        /// [`PROGRESS`] towards its target for [`LIVELOCK_AFTER`] seconds, outside the
+        /// settling band, while it covered at least [`LIVELOCK_PATH`] in each third of that
+        /// time (it moves but gets nowhere); `None` otherwise.
+        pub livelocked: Option<f64> [unit("s"), missing("no")],
         /// Smallest gap between the agent's disc and another agent's over the run, m
         /// (negative: they overlapped); `None` for an agent alone.
         pub min_separation: Option<f64> [unit("m"), missing("alone")],
@@ -180,7 +210,10 @@ pub struct Metrics {
     whole_resolves: usize,
     closest: f64,
     closer_at: f64,
+    /// `(t, path length)` about once a second over the last [`LIVELOCK_AFTER`] seconds.
+    trail: std::collections::VecDeque<(f64, f64)>,
     deadlocked: Option<f64>,
+    livelocked: Option<f64>,
     min_separation: Option<f64>,
     lateral_axis: Vector2<f64>,
     lateral_square_sum: f64,
@@ -229,7 +262,9 @@ impl Metrics {
             whole_resolves: 0,
             closest: d0,
             closer_at: 0.0,
+            trail: [(0.0, 0.0)].into(),
             deadlocked: None,
+            livelocked: None,
             min_separation: None,
             lateral_axis,
             lateral_square_sum: 0.0,
@@ -316,18 +351,76 @@ impl Metrics {
         self.min_separation = Some(self.min_separation.map_or(gap, |s| s.min(gap)));
     }
 
-    /// Watches for a deadlock after the state of time `t` (s) was recorded; `blocked` says
-    /// whether another agent is next to this one. Returns whether it was found deadlocked now.
-    pub fn watch_progress(&mut self, t: f64, blocked: bool) -> bool {
+    /// Watches an agent among others for a deadlock or a livelock after the state of time `t`
+    /// (s) was recorded; `blocked` says whether another agent is next to this one. Returns what
+    /// it was found to be now, the first time (a deadlock first, if both).
+    ///
+    /// ```
+    /// use nadf::metrics::{Metrics, Stall};
+    /// use nalgebra::Vector2;
+    /// let mut m = Metrics::new("r", [0.0, 0.0], [10.0, 0.0], None);
+    /// let mut found = None;
+    /// // Back and forth across the line to the target at 1 m/s, never closer than 10 m.
+    /// for k in 1..=2000 {
+    ///     let t = k as f64 * 0.01;
+    ///     let along = (k % 100) as f64 * 0.01;
+    ///     let y = if (k / 100) % 2 == 0 { along } else { 1.0 - along };
+    ///     m.record_state(t, Vector2::new(0.0, y), Vector2::zeros(), 1.0);
+    ///     found = found.or(m.watch_progress(t, false).map(|s| (s, t)));
+    /// }
+    /// let (stall, at) = found.expect("found");
+    /// assert_eq!(stall, Stall::Livelocked);
+    /// assert!((at - 15.0).abs() < 1e-6, "{at}");
+    /// ```
+    pub fn watch_progress(&mut self, t: f64, blocked: bool) -> Option<Stall> {
         if self.final_distance < self.closest - PROGRESS {
             (self.closest, self.closer_at) = (self.final_distance, t);
         }
-        let stuck = t - self.closer_at >= DEADLOCK_AFTER && self.final_distance > self.band;
-        if self.deadlocked.is_none() && stuck && blocked {
-            self.deadlocked = Some(t);
-            return true;
+        if self
+            .trail
+            .back()
+            .is_some_and(|&(at, _)| t >= at + 1.0 - 1e-9)
+        {
+            self.trail.push_back((t, self.path_length));
+            // One sample older than the window is kept: the path at its start.
+            while self
+                .trail
+                .get(1)
+                .is_some_and(|&(at, _)| at <= t - LIVELOCK_AFTER + 1e-9)
+            {
+                self.trail.pop_front();
+            }
         }
-        false
+        let outside = self.final_distance > self.band;
+        let still = t - self.closer_at;
+        if self.deadlocked.is_none() && still >= DEADLOCK_AFTER && outside && blocked {
+            self.deadlocked = Some(t);
+            return Some(Stall::Deadlocked);
+        }
+        let moving = self.moving_all_along(t);
+        if self.livelocked.is_none() && still >= LIVELOCK_AFTER - 1e-9 && outside && moving {
+            self.livelocked = Some(t);
+            return Some(Stall::Livelocked);
+        }
+        None
+    }
+
+    /// Whether the agent covered at least [`LIVELOCK_PATH`] in each third of the last
+    /// [`LIVELOCK_AFTER`] seconds before `t` (measured on the trail's once-a-second samples).
+    fn moving_all_along(&self, t: f64) -> bool {
+        let path_at = |at: f64| {
+            (self.trail.iter().rev())
+                .find(|&&(sampled, _)| sampled <= at + 1e-9)
+                .map(|&(_, path)| path)
+        };
+        let third = LIVELOCK_AFTER / 3.0;
+        (0..3).all(|k| {
+            let (from, to) = (t - third * (k + 1) as f64, t - third * k as f64);
+            match (path_at(from), path_at(to)) {
+                (Some(a), Some(b)) => b - a >= LIVELOCK_PATH,
+                _ => false,
+            }
+        })
     }
 
     /// Counts a re-solve of the harmonic field, which took `whole` solves over the whole grid.
@@ -381,6 +474,7 @@ impl Metrics {
             resolves: self.resolves,
             whole_resolves: self.whole_resolves,
             deadlocked: self.deadlocked,
+            livelocked: self.livelocked,
             min_separation: self.min_separation,
             intractable: None,
             map_seen: None,
@@ -459,6 +553,44 @@ mod tests {
         let s = m.summary(&straight(), &Faults::default());
         assert_eq!(s.distance_covered, Some(5.0));
         assert_eq!(s.final_speed, 0.0);
+    }
+
+    /// Runs `m` for `seconds` at 100 steps a second along `at(t)` with nobody next to it, and
+    /// returns when it was found livelocked, if it was.
+    fn livelocked_along(seconds: f64, at: impl Fn(f64) -> [f64; 2]) -> Option<f64> {
+        let mut m = Metrics::new("a", [0.0, 0.0], [10.0, 0.0], None);
+        for k in 1..=(seconds * 100.0).round() as usize {
+            let t = k as f64 * 0.01;
+            m.record_state(t, Vector2::from(at(t)), Vector2::zeros(), 1.0);
+            assert_ne!(m.watch_progress(t, false), Some(Stall::Deadlocked));
+        }
+        m.summary(&straight(), &Faults::default()).livelocked
+    }
+
+    /// Going round in a circle of 1 m behind the start at 1 m/s gets no closer to the target:
+    /// livelocked at 15 s. Driven back 4 m and parked there (the robot a jam pushes out of a
+    /// corridor), it moved without progress, but not all the while: no livelock. Nor is a
+    /// detour that leads away from the target for 6 s and then comes closer, nor a crawl
+    /// towards it at 1 cm/s.
+    #[test]
+    fn a_livelock_is_motion_without_progress_all_along() {
+        let circling = livelocked_along(30.0, |t| [t.cos() - 1.0, t.sin()]);
+        assert!(
+            circling.is_some_and(|t| (t - 15.0).abs() < 0.02),
+            "{circling:?}"
+        );
+        let driven_back = livelocked_along(30.0, |t| [-(t.min(4.0)), 0.0]);
+        assert_eq!(driven_back, None);
+        let detour = livelocked_along(30.0, |t| {
+            if t < 6.0 {
+                [-t, 0.0]
+            } else {
+                [(-6.0 + 2.0 * (t - 6.0)).min(10.0), 0.0]
+            }
+        });
+        assert_eq!(detour, None);
+        let crawl = livelocked_along(60.0, |t| [0.01 * t, (t * 3.0).sin()]);
+        assert_eq!(crawl, None);
     }
 
     #[test]

@@ -62,6 +62,12 @@ pub fn table(summaries: &[Summary]) -> String {
                 s.name
             );
         }
+        if let Some(t) = s.livelocked {
+            out += &format!(
+                "{}: livelocked at {t:.2} s: no progress towards its target, moving all the while\n",
+                s.name
+            );
+        }
         if let Some(t) = s.intractable {
             out += &format!(
                 "{}: intractable at {t:.2} s: the walls it has seen close every route to its target\n",

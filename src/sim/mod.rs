@@ -45,7 +45,7 @@ pub use sensor::Sensor;
 
 use crate::control::Neighbour;
 use crate::field::{Disc, FieldError, GuidanceField, HarmonicField};
-use crate::metrics::Summary;
+use crate::metrics::{self, Stall, Summary};
 use crate::world::{ControllerKind, FieldKind, Replan, WallShape, World, all_wall_shapes};
 
 /// A pair counts as touching when Rapier has an active contact between them whose distance is
@@ -292,7 +292,8 @@ impl Simulation {
 
     /// Records each agent's gap to the nearest other agent, and marks the agents that make no
     /// progress while another agent is next to them (within their own diameter, disc to disc)
-    /// as deadlocked, with an event in their state.
+    /// as deadlocked, and those that make none while they keep moving as livelocked, with an
+    /// event in their state.
     fn watch_neighbours(&mut self, states: &mut [AgentState]) {
         if self.agents.len() < 2 {
             return;
@@ -309,13 +310,20 @@ impl Simulation {
                 .fold(f64::INFINITY, f64::min);
             let metrics = &mut self.agents[i].metrics;
             metrics.record_separation(gap);
-            if metrics.watch_progress(self.time, gap < 2.0 * r) {
-                states[i].events.push(format!(
+            let event = match metrics.watch_progress(self.time, gap < 2.0 * r) {
+                Some(Stall::Deadlocked) => format!(
                     "deadlocked at t = {:.2} s: no progress towards the target for {} s, another agent next to it",
                     self.time,
-                    crate::metrics::DEADLOCK_AFTER
-                ));
-            }
+                    metrics::DEADLOCK_AFTER
+                ),
+                Some(Stall::Livelocked) => format!(
+                    "livelocked at t = {:.2} s: no progress towards the target for {} s, moving all the while",
+                    self.time,
+                    metrics::LIVELOCK_AFTER
+                ),
+                None => continue,
+            };
+            states[i].events.push(event);
         }
     }
 
