@@ -397,8 +397,12 @@ impl Metrics {
             self.deadlocked = Some(t);
             return Some(Stall::Deadlocked);
         }
-        let moving = self.moving_all_along(t);
-        if self.livelocked.is_none() && still >= LIVELOCK_AFTER - 1e-9 && outside && moving {
+        // The path's samples are searched last: every agent passes here at every step.
+        if self.livelocked.is_none()
+            && still >= LIVELOCK_AFTER - 1e-9
+            && outside
+            && self.moving_all_along(t)
+        {
             self.livelocked = Some(t);
             return Some(Stall::Livelocked);
         }
