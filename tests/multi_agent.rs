@@ -56,6 +56,32 @@ fn without_replanning_the_robots_run_into_each_other_and_it_counts() {
     }
 }
 
+/// A crowd parked on its targets is not re-solved ten times a second: once the last robot has
+/// settled and none moves, a replan would solve the field each already has, and is skipped.
+/// Replanning goes on while any moves (each robot re-solves until about the last settles).
+#[test]
+fn a_parked_crowd_is_not_re_solved() {
+    let world = common::world("crowd.toml", &["duration=40"]);
+    let report = nadf::run::run(&world, &Default::default()).unwrap();
+    let last = (report.agents.iter())
+        .map(|s| s.settling_time.expect("every robot settles"))
+        .fold(0.0, f64::max);
+    assert!(last < 20.0, "{last}");
+    for s in &report.agents {
+        // 400 replans were due over the 40 s; those after the last settling are skipped.
+        let until_parked = ((last + 2.0) * world.field.replan_hz) as usize;
+        assert!(
+            s.resolves <= until_parked,
+            "{} after {last} s: {s:?}",
+            s.resolves
+        );
+        assert!(
+            s.resolves >= (s.settling_time.unwrap() * 5.0) as usize,
+            "{s:?}"
+        );
+    }
+}
+
 #[test]
 fn a_crowd_crosses_the_room_without_contact() {
     let report = nadf::run::run(&common::world("crowd.toml", &[]), &Default::default()).unwrap();
@@ -87,6 +113,10 @@ fn a_jam_is_reported_as_deadlocked_and_a_swap_is_not() {
     assert!((5.0..15.0).contains(&at), "{west:?}");
     assert!(!west.reached && west.contacts == 0, "{west:?}");
     assert_eq!((east.livelocked, west.livelocked), (None, None), "{west:?}");
+    // Parked short of its target, the west robot is still replanned at every replan due
+    // (only a crowd parked on its targets skips them): 151 of the 199 due in 20 s re-solve
+    // (the others give no usable field); skipping where nothing moved left 77.
+    assert!(west.resolves >= 140, "{west:?}");
     for name in ["swap.toml", "crowd.toml"] {
         let world = common::world(name, &[]);
         let report = nadf::run::run(&world, &nadf::run::RunOptions::default()).unwrap();

@@ -129,7 +129,8 @@ crate::measured! {
         /// (negative: they overlapped); `None` for an agent alone.
         pub min_separation: Option<f64> [unit("m"), missing("alone")],
         /// Successful re-solves of the harmonic field (sensor readings, replans, lidar map
-        /// changes); the first solve is not counted.
+        /// changes); the first solve is not counted, nor a replan skipped because the crowd is
+        /// parked on its targets and nothing moved since the last one (see `sim::agent::STILL`).
         pub resolves: usize [column("resolves")],
         /// Solves over the whole grid that the re-solves took (a replan may take two): a
         /// crowd's local replans that fell back to the whole field (cut off in the window, or
