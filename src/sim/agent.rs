@@ -531,8 +531,10 @@ impl AgentRun {
         // the run). Not a crowd stuck short of its targets: there a replan may change who
         // gives way (measured: skipping every replan where nothing moved froze a door swap
         // of 16 robots with 13 short of their targets, where 15 arrive otherwise).
-        let parked = (Vector2::from(self.agent.target) - x).norm() <= self.metrics.band()
-            && crowd.iter().all(|(_, (arrived, _))| *arrived);
+        let parked = || {
+            (Vector2::from(self.agent.target) - x).norm() <= self.metrics.band()
+                && crowd.iter().all(|(_, (arrived, _))| *arrived)
+        };
         let still = |(x0, discs): &(Vector2<f64>, Vec<Disc>)| {
             let by = STILL * world.field.cell;
             (x - x0).norm() <= by
@@ -542,7 +544,7 @@ impl AgentRun {
                     moved <= by && (a.radius - b.radius).abs() <= by
                 })
         };
-        let skipped = replan_due && parked && self.solved_among.as_ref().is_some_and(still);
+        let skipped = replan_due && parked() && self.solved_among.as_ref().is_some_and(still);
         plan.rebuild = plan.walls_changed || (replan_due && !skipped);
         if plan.rebuild && index < crowd.len() {
             // Agent k is `others[k]` before this one and `others[k - 1]` after it.
