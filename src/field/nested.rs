@@ -54,10 +54,25 @@ pub const REACH: usize = 8;
 /// end of a dead end, where the solve's own error could leave it negative.)
 pub const FLOOR: f64 = 1e-11;
 /// Steps from the accepted cells that a band's core covers at first. The extent adapts: it
-/// doubles after a level in which the cut, rather than the depth, limited what was accepted
-/// (`W` falls slowly there: a wide region), and halves back towards this after one in which
-/// the depth did (a narrow corridor).
+/// doubles after each level in which the cut, rather than the depth, limited what was
+/// accepted (`W` falls slowly there: a wide region), until a level is limited by the depth;
+/// from then on it grows by [`CORE_GROWTH`] after a level the cut limited and shrinks by
+/// [`CORE_SHRINK`] (not below this) after one the depth did (a narrow corridor).
 pub const CORE_STEPS: u32 = 8;
+/// The factor a band's core grows by after a level the cut limited, once the extent has first
+/// been enough. A level accepts what the depth allows whatever the extent beyond it, so an
+/// extent past the cut's reach only costs: in steps of 1.5 and 0.75 the extent settles near
+/// the least that the cut does not limit, where doubling and halving swung it between too
+/// short and twice too long. (Doubling at first, until the extent is first enough, reaches a
+/// wide region in as few levels as before: every field that is never depth-limited solves
+/// exactly as it did.) Measured on the rooms map's longest field (2560² cells, 626 decades
+/// deep): doubling and halving took 141 levels with the core swinging 64 → 128 → 256 steps
+/// and back, 22.7 M cells solved, 20.6–22.0 s; these, 130 levels, 15.6 M cells, 13.2 s.
+/// Growing by 1.5 from the start cost `map-depot` 451 k cells against 325 k (0.30 s against
+/// 0.22 s).
+pub const CORE_GROWTH: f64 = 1.5;
+/// The factor a band's core shrinks by after a level the depth limited (see [`CORE_GROWTH`]).
+pub const CORE_SHRINK: f64 = 0.75;
 /// The largest extent of a band's core, in steps.
 pub const MAX_CORE_STEPS: u32 = 1 << 16;
 /// An estimate of at least this fraction of its solve's scale is reliable enough to extend a
@@ -180,6 +195,9 @@ struct Levels<'a> {
     level: u32,
     /// The extent of the next band's core, in steps.
     core_steps: u32,
+    /// Whether a level has been limited by the depth rather than the cut: the core's extent
+    /// was enough once, and is tuned from then on rather than doubled.
+    settled: bool,
     stats: LevelStats,
 }
 
@@ -205,6 +223,7 @@ pub fn solve_levels(
         stamp: 0,
         level: 0,
         core_steps: CORE_STEPS,
+        settled: false,
         stats: LevelStats::default(),
         pending,
     };
@@ -275,11 +294,16 @@ impl Levels<'_> {
             accepted.extend(resolved);
             cut_limited |= limited;
         }
-        self.core_steps = if cut_limited {
-            (2 * self.core_steps).min(MAX_CORE_STEPS)
+        self.settled |= !cut_limited;
+        let steps = f64::from(self.core_steps);
+        let steps = if cut_limited && !self.settled {
+            2.0 * steps
+        } else if cut_limited {
+            (CORE_GROWTH * steps).ceil()
         } else {
-            (self.core_steps / 2).max(CORE_STEPS)
+            (CORE_SHRINK * steps).floor()
         };
+        self.core_steps = (steps as u32).clamp(CORE_STEPS, MAX_CORE_STEPS);
         for &k in &accepted {
             self.pending[k] = false;
         }
