@@ -457,6 +457,12 @@ impl AgentRun {
         others: Vec<Neighbour>,
         (index, crowd): (usize, &[CrowdMember]),
     ) -> Plan {
+        // The last whole field is kept only while it may serve as a starting guess: held
+        // past that it costs as much memory as the agent's own field (measured: 64 robots on
+        // a 39 m grid, 117 MB), and a crowd parked on its targets replans no more to drop it.
+        if (self.last_whole.as_ref()).is_some_and(|(_, at)| time - at >= WARM_FOR) {
+            self.last_whole = None;
+        }
         let (x, v) = self.read_state(physics);
         let mut plan = Plan {
             x,
@@ -610,12 +616,12 @@ impl AgentRun {
         // Solves over the whole grid, counted (see `Summary::whole_resolves`).
         let whole = std::cell::Cell::new(0);
         // A whole field among the others starts from the last one solved among them while that
-        // is recent (the others moved little since), else from the last field, whose values
-        // over the whole grid are the walls' alone with local replanning (measured: 64 robots
-        // on a 1.8 m circle, a tenth less time in these solves).
+        // is recent (the others moved little since; `plan` drops it after that), else from the
+        // last field, whose values over the whole grid are the walls' alone with local
+        // replanning (measured: 64 robots on a 1.8 m circle, a tenth less time in these solves).
         let warm = |others: &[Disc]| {
             (self.last_whole.as_ref())
-                .filter(|(_, at)| !others.is_empty() && plan.time - at < WARM_FOR)
+                .filter(|_| !others.is_empty())
                 .map_or(field, |(f, _)| f)
         };
         // The whole field solved among the others for a local replan, if one was.
@@ -1009,10 +1015,9 @@ impl AgentRun {
                     self.walls = Some(walls);
                     self.last_whole = None;
                 }
-                // Kept only while it may serve: a whole field held past that costs as much
-                // memory as the agent's own (measured: 64 robots on a 39 m grid, 117 MB).
-                let recent = (self.last_whole.take()).filter(|(_, at)| plan.time - at < WARM_FOR);
-                self.last_whole = (new.whole_among.map(|whole| (whole, plan.time))).or(recent);
+                if let Some(whole) = new.whole_among {
+                    self.last_whole = Some((whole, plan.time));
+                }
                 self.solved_among = Some((plan.x, plan.others.clone()));
                 self.rebuild_failed = false;
                 self.metrics.record_resolve(new.whole);
