@@ -126,8 +126,13 @@ fn local_replanning_guides_like_a_full_re_solve() {
         replan_reach: 0.0,
         ..world.field.clone()
     };
+    // A coarse window of 5 m, less than the room (the default 24 m covers all of it).
+    let near = nadf::world::FieldSettings {
+        replan_reach: 5.0,
+        ..world.field.clone()
+    };
     let mut sim = nadf::sim::Simulation::new(&world).unwrap();
-    let (mut local, mut window) = (Vec::new(), Vec::new());
+    let [mut local, mut window, mut wide, mut local5] = [(); 4].map(|_| Vec::new());
     let mut steps = 0;
     while !sim.finished() {
         sim.step();
@@ -158,8 +163,10 @@ fn local_replanning_guides_like_a_full_re_solve() {
                 nadf::field::HarmonicField::solve_among(&world, &run.agent, p, &[], &others, None),
                 walls.with_window(&run.agent, p, &others, &world.field),
                 walls.with_window(&run.agent, p, &others, &window_only),
+                walls.with_wide_window(&run.agent, p, &others, &near),
+                walls.with_window(&run.agent, p, &others, &near),
             );
-            let (Ok(full), Ok(a), Ok(b)) = solved else {
+            let (Ok(full), Ok(a), Ok(b), Some(Ok(c)), Ok(e)) = solved else {
                 continue;
             };
             let angle = |f: &nadf::field::HarmonicField| {
@@ -167,9 +174,11 @@ fn local_replanning_guides_like_a_full_re_solve() {
                 let cos = g.dot(&h) / (g.norm() * h.norm());
                 Some(cos.clamp(-1.0, 1.0).acos().to_degrees())
             };
-            if let (Some(a), Some(b)) = (angle(&a), angle(&b)) {
+            if let [Some(a), Some(b), Some(c), Some(e)] = [&a, &b, &c, &e].map(angle) {
                 local.push(a);
                 window.push(b);
+                wide.push(c);
+                local5.push(e);
             }
         }
     }
@@ -178,9 +187,9 @@ fn local_replanning_guides_like_a_full_re_solve() {
         let at = |q: f64| angles[((angles.len() - 1) as f64 * q).round() as usize];
         [at(0.5), at(0.75), at(0.9), at(0.99)]
     };
-    let (l, w) = (quantiles(&mut local), quantiles(&mut window));
+    let [l, w, d, e] = [&mut local, &mut window, &mut wide, &mut local5].map(quantiles);
     eprintln!(
-        "angle to a full re-solve over {} samples (median, 75th, 90th, 99th percentile): local {l:.2?}°, window alone {w:.2?}°",
+        "angle to a full re-solve over {} samples (median, 75th, 90th, 99th percentile): local {l:.2?}°, window alone {w:.2?}°, local with a 5 m reach {e:.2?}°, wide {d:.2?}°",
         local.len()
     );
     assert!(local.len() > 200, "{}", local.len());
@@ -190,6 +199,10 @@ fn local_replanning_guides_like_a_full_re_solve() {
     assert!(l[0] < 2.0 && l[1] < 6.0 && l[2] < 30.0, "{l:?}");
     // The coarse window is what brings the far agents in.
     assert!(l[1] < w[1], "{l:?} {w:?}");
+    // The wide window (the first arbiter of a window that turns back), with the whole grid's
+    // field among the others at the coarse cell on its edge, is nearer the full re-solve than
+    // a local window whose coarse window leaves part of the room out.
+    assert!(d[1] < e[1] && d[2] < e[2], "{d:?} {e:?}");
 
     for file in ["crowds/circle-8.toml", "crowds/circle-16.toml"] {
         let reached = |mode: &str| -> Vec<bool> {

@@ -20,7 +20,7 @@ use super::mask::CellCounts;
 use super::multigrid;
 use super::nested::{DEPTH_STEP, LevelStats, MAX_ITERATIONS, deep_cells, solve_levels};
 use super::scaled::{ScaledW, ldexp};
-use super::window::Window;
+use super::window::{Reach, Window};
 use super::{Disc, FieldError, FreeSpace, KnownMap, Sampler, Streamline};
 use crate::control::unit;
 use crate::world::{Agent, FieldSettings, World};
@@ -168,6 +168,69 @@ impl HarmonicField {
         others: &[Disc],
         settings: &FieldSettings,
     ) -> Result<Self, FieldError> {
+        self.windowed(
+            agent,
+            position,
+            others,
+            settings,
+            Reach::Around(settings.replan_reach),
+        )
+    }
+
+    /// [`HarmonicField::with_window`] with the window's edge from the field among the others
+    /// over the whole grid at four times the cell ([`Reach::Whole`]) instead of a coarse window
+    /// around the agent: which way a crowd leaves, wherever it leaves it, at a sixteenth of
+    /// the cells of a full re-solve. The arbiter of a window whose guidance turns back on the
+    /// agent's last field. `None` where the coarse window around the agent (`replan_reach`)
+    /// already covers the grid: the wide window would be the window's own problem again, and
+    /// what is left to tell them apart is the coarse cell, which only the full re-solve
+    /// resolves.
+    ///
+    /// ```
+    /// # let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/room-two-dividers.toml");
+    /// # let world = nadf::world::load(&path, &["field.cell=0.1".parse().unwrap()]).unwrap();
+    /// use nadf::field::{Disc, HarmonicField};
+    /// let agent = &world.agents[0];
+    /// let walls = HarmonicField::solve(&world, agent).unwrap();
+    /// // A row of robots across the guidance, 2 m ahead in the gap the agent heads for.
+    /// let [x, y] = agent.start;
+    /// let g = walls.gradient(agent.start).unwrap().normalize();
+    /// let across = |s: f64| [x - 2.0 * g.x - s * g.y, y - 2.0 * g.y + s * g.x];
+    /// let others: Vec<Disc> = (-1..=1)
+    ///     .map(|k| Disc { center: across(0.5 * k as f64), radius: 0.25 })
+    ///     .collect();
+    /// // A coarse window of 4 m, so that the whole grid's is wider.
+    /// let settings = nadf::world::FieldSettings { replan_reach: 4.0, ..world.field.clone() };
+    /// let wide = walls.with_wide_window(agent, agent.start, &others, &settings).unwrap().unwrap();
+    /// assert!(walls.with_wide_window(agent, agent.start, &others, &world.field).is_none());
+    /// let full = HarmonicField::solve_among(&world, agent, agent.start, &[], &others, None).unwrap();
+    /// // The same way round the robots as the full re-solve's.
+    /// let (a, b) = (wide.gradient(agent.start).unwrap(), full.gradient(agent.start).unwrap());
+    /// assert!(a.dot(&b) / (a.norm() * b.norm()) > 0.9);
+    /// ```
+    pub fn with_wide_window(
+        &self,
+        agent: &Agent,
+        position: [f64; 2],
+        others: &[Disc],
+        settings: &FieldSettings,
+    ) -> Option<Result<Self, FieldError>> {
+        let grid = self.grid();
+        let (lo, reach) = (grid.origin, settings.replan_reach);
+        let hi = [0, 1].map(|a| lo[a] + grid.cell * [grid.nx, grid.ny][a] as f64);
+        let covered = (0..2).all(|a| position[a] - reach <= lo[a] && position[a] + reach >= hi[a]);
+        (!covered).then(|| self.windowed(agent, position, others, settings, Reach::Whole))
+    }
+
+    /// This field with a window around `position` whose coarse window extends to `reach`.
+    fn windowed(
+        &self,
+        agent: &Agent,
+        position: [f64; 2],
+        others: &[Disc],
+        settings: &FieldSettings,
+        reach: Reach,
+    ) -> Result<Self, FieldError> {
         let values = (
             self.grid(),
             self.sampler.reachable_cells(),
@@ -177,7 +240,7 @@ impl HarmonicField {
             values,
             agent,
             position,
-            (settings.replan_window, settings.replan_reach),
+            (settings.replan_window, reach),
             (others, self.window.as_deref()),
             settings.tolerance.max(super::window::WINDOW_TOLERANCE),
         )?;

@@ -58,7 +58,7 @@ pub use sample::Sampler;
 pub use scaled::ScaledW;
 pub use space::ConfigurationSpace;
 pub use streamline::Streamline;
-pub use window::Window;
+pub use window::{Reach, Window};
 pub use yielding::{CLEAR_OF_WAY, IN_THE_WAY, WAY_AHEAD, Way};
 
 /// The solver's internals, public for the benchmarks only: not part of the crate's API.

@@ -111,10 +111,26 @@ pub const COARSE_REUSE: u32 = 4;
 /// the default 1e-12. Cells below what it resolves go to the nested levels as in a full solve.
 pub const WINDOW_TOLERANCE: f64 = 1e-9;
 
+/// How far the coarse window that gives a window's edge extends.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reach {
+    /// This many metres either side of the agent (`replan_reach`; no coarse window when it is
+    /// not beyond the window's own half-side). The next replans may reuse it
+    /// (`COARSE_REUSE`, see [`Window`]).
+    Around(f64),
+    /// The whole grid, solved for this window alone and never reused: the field among the
+    /// others over the whole grid at `COARSE` (4) times the cell, for a window whose guidance
+    /// turns back on the agent's last field (which way is right only a field over the whole
+    /// grid can say, and at the coarse cell it costs a sixteenth of the fine one's cells).
+    Whole,
+}
+
 /// A coarse window, and how it was made.
 #[derive(Debug)]
 struct Coarse {
     sampler: Arc<Sampler>,
+    /// Whether it covers the whole grid ([`Reach::Whole`]): such a window is never reused.
+    whole: bool,
     /// Where the agent was when it was solved, m.
     centre: [f64; 2],
     /// Replans it has served since.
@@ -140,13 +156,18 @@ impl Window {
     /// bend the guidance (a crowd ahead is gone around early), at the cost of a second window
     /// of about as many cells, whatever the size of the world.
     ///
+    /// With [`Reach::Whole`] the coarse window covers the whole grid, and its values alone make
+    /// the fine window's ring (0 where it has none): it knows the detours the others leave
+    /// beyond any window, so the fine window is not asked to lead on along the field of the
+    /// walls (`leads_on`), only not to be cut off.
+    ///
     /// `previous` is the window of the last replan on the same field of the walls, whose
     /// coarse window may serve again ([`COARSE_REUSE`]).
     pub(super) fn solve(
         (grid, reachable, w): (&Grid, &[bool], &ScaledW),
         agent: &Agent,
         position: [f64; 2],
-        (half, reach): (f64, f64),
+        (half, reach): (f64, Reach),
         (others, previous): (&[Disc], Option<&Window>),
         tolerance: f64,
     ) -> Result<Self, FieldError> {
@@ -155,20 +176,29 @@ impl Window {
             agent: agent.name.clone(),
             radius: agent.radius,
         };
+        let whole = reach == Reach::Whole;
+        // The coarse window's half-side: the whole grid's extent covers it from anywhere.
+        let reach = match reach {
+            Reach::Around(reach) => reach,
+            Reach::Whole => grid.cell * (grid.nx.max(grid.ny) as f64),
+        };
         let discs: Vec<Disc> = obstacle_discs(agent, position, grid.cell, others)
             .filter(|d| {
                 let r = d.radius + agent.radius + half.max(reach);
                 (d.center[0] - position[0]).abs() < r && (d.center[1] - position[1]).abs() < r
             })
             .collect();
-        let reusable = previous.and_then(|p| p.coarse.as_ref()).filter(|c| {
-            c.reused < COARSE_REUSE
+        let reusable = (previous.and_then(|p| p.coarse.as_ref())).filter(|c| {
+            !whole
+                && !c.whole
+                && c.reused < COARSE_REUSE
                 && (c.centre[0] - position[0]).hypot(c.centre[1] - position[1]) < 0.25 * reach
         });
         let mut coarse_iterations = 0;
         let coarse = match reusable {
             Some(c) => Some(Arc::new(Coarse {
                 sampler: Arc::clone(&c.sampler),
+                whole: false,
                 centre: c.centre,
                 reused: c.reused + 1,
             })),
@@ -179,6 +209,7 @@ impl Window {
                         coarse_iterations = iterations;
                         Some(Arc::new(Coarse {
                             sampler: Arc::new(sampler),
+                            whole,
                             centre: position,
                             reused: 0,
                         }))
@@ -221,14 +252,22 @@ impl Window {
             problem.known[k] = !problem.free[k] || ring;
             (problem.values.mantissa[k], problem.values.exponent[k]) =
                 (w.mantissa[g], w.exponent[g]);
-            // The ring from the coarse window where it has a value there.
+            // The ring from the coarse window where it has a value there (with the whole
+            // grid's coarse window, only there: the field of the walls would lead into what
+            // it shows closed).
             if ring
                 && problem.free[k]
                 && let Some(coarse) = &coarse
-                && let Some((m, e)) = coarse.sampler.w_scaled(centre)
-                && m > 0.0
             {
-                (problem.values.mantissa[k], problem.values.exponent[k]) = (m, e);
+                match coarse.sampler.w_scaled(centre) {
+                    Some((m, e)) if m > 0.0 => {
+                        (problem.values.mantissa[k], problem.values.exponent[k]) = (m, e);
+                    }
+                    _ if whole => {
+                        (problem.values.mantissa[k], problem.values.exponent[k]) = (0.0, 0);
+                    }
+                    _ => {}
+                }
             }
         }
         for g in disc_cells(
@@ -242,7 +281,7 @@ impl Window {
                 problem.known[local.index(gi - ir.start, gj - jr.start)] = true;
             }
         }
-        if !leads_on(&problem, (grid, reachable, w), (&ir, &jr), position) {
+        if !whole && !leads_on(&problem, (grid, reachable, w), (&ir, &jr), position) {
             return Err(unreachable());
         }
         let (sampler, iterations) = solve_problem(problem, agent, position, tolerance)?;
@@ -501,4 +540,52 @@ fn leads_on(
         }
     }
     false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::HarmonicField;
+
+    /// A wide window's coarse window covers the whole grid and never serves a later window
+    /// (the field among the others over the whole grid, held as the edge of the next windows,
+    /// milled crossing flows about for good: see the commit that reverted that reuse); an
+    /// ordinary coarse window serves the next replan.
+    #[test]
+    fn a_wide_windows_coarse_window_covers_the_grid_and_is_not_reused() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/crowds/circle-16.toml");
+        let world = crate::world::load(&path, &[]).unwrap();
+        let agent = &world.agents[0];
+        let walls = HarmonicField::solve(&world, agent).unwrap();
+        let others: Vec<Disc> = (world.agents[1..].iter())
+            .map(|a| Disc {
+                center: a.start,
+                radius: a.radius,
+            })
+            .collect();
+        let coarse = |f: &HarmonicField| f.window.as_ref().unwrap().coarse.clone().unwrap();
+        let settings = crate::world::FieldSettings {
+            replan_reach: 4.0,
+            ..world.field.clone()
+        };
+        let wide = walls
+            .with_wide_window(agent, agent.start, &others, &settings)
+            .unwrap()
+            .unwrap();
+        let covered = coarse(&wide).sampler.grid().len() * COARSE * COARSE;
+        assert!(
+            coarse(&wide).whole && covered >= walls.grid().len(),
+            "{covered}"
+        );
+        let next = wide
+            .with_window(agent, agent.start, &others, &settings)
+            .unwrap();
+        assert!(!coarse(&next).whole && coarse(&next).reused == 0);
+        let again = next
+            .with_window(agent, agent.start, &others, &settings)
+            .unwrap();
+        assert!(Arc::ptr_eq(&coarse(&next).sampler, &coarse(&again).sampler));
+        assert_eq!(coarse(&again).reused, 1);
+    }
 }

@@ -133,12 +133,27 @@ impl FreeSpace {
             .cell_of(position)
             .filter(|&(i, j)| !blocked[grid.index(i, j)])?;
         let connected = laplace::reachable_from(grid, blocked, here);
+        // The cells not clear of a way: each way's own box, grown by how far its reach goes,
+        // is searched (a cell outside it is farther than that from every point of the way),
+        // not the whole grid against every way.
+        let mut near = vec![false; grid.len()];
+        for way in ways {
+            let reach = way.radius + agent.radius + CLEAR_OF_WAY;
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for p in way.points.iter() {
+                lo = [lo[0].min(p[0] - reach), lo[1].min(p[1] - reach)];
+                hi = [hi[0].max(p[0] + reach), hi[1].max(p[1] + reach)];
+            }
+            let (ir, jr) = grid.cells_in(lo, hi);
+            for j in jr {
+                for i in ir.clone() {
+                    let k = grid.index(i, j);
+                    near[k] = near[k] || !way.clear(grid.center(i, j), agent.radius);
+                }
+            }
+        }
         let target_cells: Vec<usize> = (0..grid.len())
-            .filter(|&k| connected[k])
-            .filter(|&k| {
-                let p = grid.center(k % grid.nx, k / grid.nx);
-                ways.iter().all(|w| w.clear(p, agent.radius))
-            })
+            .filter(|&k| connected[k] && !near[k])
             .collect();
         let first = *target_cells.first()?;
         Some(Self {
@@ -250,6 +265,11 @@ mod tests {
         };
         let way = Way::new(&straight([0.0, 2.0], [4.0, 2.0], 40), 0.3);
         let space = FreeSpace::out_of_ways(&grid, &blocked, &agent, [2.0, 2.0], &[&way]).unwrap();
+        // The target cells are exactly the cells clear of the way.
+        let clear: Vec<usize> = (0..grid.len())
+            .filter(|&k| way.clear(grid.center(k % grid.nx, k / grid.nx), agent.radius))
+            .collect();
+        assert_eq!(space.target_cells, clear);
         // Every target cell is clear of the way; the cells near it are not targets.
         for &k in &space.target_cells {
             let p = grid.center(k % grid.nx, k / grid.nx);

@@ -82,12 +82,92 @@ pub fn solve(
     tolerance: f64,
     max_iterations: usize,
 ) -> Stats {
+    match Crop::of(grid, unknown) {
+        Some(crop) => crop.solve(grid, unknown, values, tolerance, max_iterations),
+        None => solve_all(grid, unknown, values, tolerance, max_iterations),
+    }
+}
+
+/// [`solve`] over the whole of `grid`.
+fn solve_all(
+    grid: &Grid,
+    unknown: &[bool],
+    values: &mut [f64],
+    tolerance: f64,
+    max_iterations: usize,
+) -> Stats {
     let mut hierarchy = Hierarchy::new(grid.nx, grid.ny, unknown);
     let fine = &hierarchy.levels[0];
     let mut cg = Krylov::start(fine, grid, unknown, values);
     let stats = cg.iterate(&mut hierarchy, tolerance, max_iterations);
     cg.copy_out(&hierarchy.levels[0], grid, unknown, values);
     stats
+}
+
+/// The box of a grid that holds every unknown cell and the cells next to them, when it is at
+/// most half the grid: a problem whose unknowns are few among many Dirichlet cells (the field
+/// that takes a yielding agent out of the others' ways: `W = 1` on every free cell clear of
+/// them) is solved on that box. The system is the same (no cell outside the box is a neighbour
+/// of an unknown), and the hierarchy, the cycles and the passes over the vectors cost the box's
+/// cells instead of the grid's.
+struct Crop {
+    /// The box's cells along x and y, in the grid's cell indices.
+    i: std::ops::Range<usize>,
+    j: std::ops::Range<usize>,
+}
+
+impl Crop {
+    /// The box of `grid` around its `unknown` cells, if it is at most half the grid (and not
+    /// empty).
+    fn of(grid: &Grid, unknown: &[bool]) -> Option<Self> {
+        let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
+        for (k, _) in unknown.iter().enumerate().filter(|(_, u)| **u) {
+            let (i, j) = (k % grid.nx, k / grid.nx);
+            lo = [lo[0].min(i), lo[1].min(j)];
+            hi = [hi[0].max(i), hi[1].max(j)];
+        }
+        if lo[0] == usize::MAX {
+            return None;
+        }
+        let i = lo[0].saturating_sub(1)..(hi[0] + 2).min(grid.nx);
+        let j = lo[1].saturating_sub(1)..(hi[1] + 2).min(grid.ny);
+        (2 * i.len() * j.len() <= grid.len()).then_some(Self { i, j })
+    }
+
+    /// [`solve`] on the box: its cells copied out, solved, and the unknown ones copied back.
+    fn solve(
+        &self,
+        grid: &Grid,
+        unknown: &[bool],
+        values: &mut [f64],
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Stats {
+        let sub = Grid {
+            nx: self.i.len(),
+            ny: self.j.len(),
+            cell: grid.cell,
+            origin: grid
+                .center(self.i.start, self.j.start)
+                .map(|c| c - 0.5 * grid.cell),
+        };
+        let global = |k: usize| grid.index(self.i.start + k % sub.nx, self.j.start + k / sub.nx);
+        let sub_unknown: Vec<bool> = (0..sub.len()).map(|k| unknown[global(k)]).collect();
+        let mut sub_values: Vec<f64> = (0..sub.len()).map(|k| values[global(k)]).collect();
+        let stats = solve_all(
+            &sub,
+            &sub_unknown,
+            &mut sub_values,
+            tolerance,
+            max_iterations,
+        );
+        for (k, v) in sub_values.into_iter().enumerate() {
+            if sub_unknown[k] {
+                values[global(k)] = v;
+            }
+        }
+        stats
+    }
 }
 
 #[cfg(test)]
@@ -183,6 +263,46 @@ mod tests {
             counts.iter().max().unwrap() - counts.iter().min().unwrap() <= 1 && counts[2] <= 13,
             "{counts:?}"
         );
+    }
+
+    /// A few unknowns among many Dirichlet cells are solved on their box (see `Crop`): the
+    /// same solution as over the whole grid, to the tolerance, and no cell outside the box is
+    /// written. The unknowns: a ring of cells around a square held at 1, at the grid's corner
+    /// and in its middle; everything else fixed at 0.5 or 0.
+    #[test]
+    fn few_unknowns_are_solved_on_their_box() {
+        let grid = Grid::covering([2.0, 2.0], 1.0 / 64.0);
+        for corner in [0, 50] {
+            let mut unknown = vec![false; grid.len()];
+            let mut w = vec![0.5; grid.len()];
+            for j in corner..corner + 20 {
+                for i in corner..corner + 30 {
+                    let k = grid.index(i, j);
+                    let inner = (5..25).contains(&(i - corner)) && (5..15).contains(&(j - corner));
+                    (unknown[k], w[k]) = if inner { (false, 1.0) } else { (true, 0.0) };
+                }
+            }
+            let crop = Crop::of(&grid, &unknown).expect("a small box");
+            assert_eq!(
+                (crop.i.len(), crop.j.len()),
+                (
+                    30 + 1 + usize::from(corner > 0),
+                    20 + 1 + usize::from(corner > 0)
+                )
+            );
+            let mut whole = w.clone();
+            let on_box = solve(&grid, &unknown, &mut w, 1e-12, 100);
+            let all = solve_all(&grid, &unknown, &mut whole, 1e-12, 100);
+            assert!(on_box.relative_residual <= 1e-12 && all.relative_residual <= 1e-12);
+            let worst = (w.iter().zip(&whole))
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(worst < 1e-10, "largest difference {worst:e}");
+            assert!((0..grid.len()).all(|k| unknown[k] || w[k] == whole[k]));
+        }
+        // A problem that fills the grid is solved over all of it.
+        let (grid, unknown, _) = divided_room(64);
+        assert!(Crop::of(&grid, &unknown).is_none());
     }
 
     /// CG updates its residual rather than recomputing it, from a search direction rounded to
