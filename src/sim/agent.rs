@@ -686,17 +686,16 @@ impl AgentRun {
                     // the window moved with the agent and the field of the walls on its edge
                     // disagrees with the others beyond it (at a crowd parked by a door, the
                     // agent turns back and forth between two windows for good). Which way is
-                    // right only a field over the whole grid can say. First the wide window
-                    // (the whole grid's field among the others at the coarse cell on its edge,
-                    // a sixteenth of the cells): where it keeps the last field's way, what
-                    // turned the window was its coarse window's edge, and the wide window
-                    // stands. Where it turns back too, or cannot say (or the coarse window
-                    // already covers the grid, and what is left is the coarse cell: two groups
-                    // swapping through a door, a robot of 16 livelocked when the wide window
-                    // decided there), the whole field decides.
+                    // right only a field over the whole grid can say: in a room wider than
+                    // the coarse window, the wide window (the whole grid's field among the
+                    // others at the coarse cell on its edge, a sixteenth of the cells), which
+                    // has no edge that moves with the agent; else the whole field (where the
+                    // coarse window covers the room, the wide window is the window's own
+                    // problem again: two groups swapping through a door, one robot of 16
+                    // livelocked when it decided there).
                     Ok(window) if turns_back(field, &window, plan.x) => {
                         match walls.with_wide_window(&self.agent, x, others, &world.field) {
-                            Some(Ok(wide)) if !turns_back(field, &wide, plan.x) => Ok(wide),
+                            Some(Ok(wide)) => Ok(wide),
                             _ => whole_among_others(others),
                         }
                     }
