@@ -125,6 +125,24 @@ impl Grid {
             range(lo[1], hi[1], self.origin[1], self.ny),
         )
     }
+
+    /// The part of this grid made of the cells `i` along x and `j` along y: the same cells,
+    /// numbered from the part's corner (a window, a box around some cells).
+    ///
+    /// ```
+    /// let grid = nadf::field::Grid::covering([2.0, 1.0], 0.1);
+    /// let part = grid.part(3..8, 2..4);
+    /// assert_eq!((part.nx, part.ny), (5, 2));
+    /// assert_eq!(part.center(0, 0), grid.center(3, 2));
+    /// ```
+    pub fn part(&self, i: std::ops::Range<usize>, j: std::ops::Range<usize>) -> Grid {
+        Grid {
+            nx: i.len(),
+            ny: j.len(),
+            cell: self.cell,
+            origin: self.center(i.start, j.start).map(|c| c - 0.5 * self.cell),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -475,12 +475,7 @@ impl Levels<'_> {
         }
         let (i0, j0) = (lo[0].saturating_sub(1), lo[1].saturating_sub(1));
         let (i1, j1) = ((hi[0] + 1).min(g.nx - 1), (hi[1] + 1).min(g.ny - 1));
-        let sub = Grid {
-            nx: i1 - i0 + 1,
-            ny: j1 - j0 + 1,
-            cell: g.cell,
-            origin: g.center(i0, j0).map(|c| c - 0.5 * g.cell),
-        };
+        let sub = g.part(i0..i1 + 1, j0..j1 + 1);
         let local = |k: usize| sub.index(k % g.nx - i0, k / g.nx - j0);
         let mut unknown = vec![false; sub.len()];
         for &k in cells {

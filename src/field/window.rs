@@ -230,12 +230,7 @@ impl Window {
             [position[0] - half, position[1] - half],
             [position[0] + half, position[1] + half],
         );
-        let local = Grid {
-            nx: ir.len(),
-            ny: jr.len(),
-            cell: grid.cell,
-            origin: grid.center(ir.start, jr.start).map(|c| c - 0.5 * grid.cell),
-        };
+        let local = grid.part(ir.clone(), jr.clone());
         if local.nx < 3 || local.ny < 3 {
             return Err(unreachable());
         }

@@ -143,14 +143,7 @@ impl Crop {
         tolerance: f64,
         max_iterations: usize,
     ) -> Stats {
-        let sub = Grid {
-            nx: self.i.len(),
-            ny: self.j.len(),
-            cell: grid.cell,
-            origin: grid
-                .center(self.i.start, self.j.start)
-                .map(|c| c - 0.5 * grid.cell),
-        };
+        let sub = grid.part(self.i.clone(), self.j.clone());
         let global = |k: usize| grid.index(self.i.start + k % sub.nx, self.j.start + k / sub.nx);
         let sub_unknown: Vec<bool> = (0..sub.len()).map(|k| unknown[global(k)]).collect();
         let mut sub_values: Vec<f64> = (0..sub.len()).map(|k| values[global(k)]).collect();
