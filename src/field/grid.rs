@@ -126,6 +126,48 @@ impl Grid {
         )
     }
 
+    /// The corners of the grid's extent, m: `(origin, origin + (nx, ny) · cell)`.
+    ///
+    /// ```
+    /// let grid = nadf::field::Grid::covering([2.0, 1.0], 0.5);
+    /// assert_eq!(grid.bounds(), ([0.0, 0.0], [2.0, 1.0]));
+    /// ```
+    pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        let hi = [
+            self.origin[0] + self.nx as f64 * self.cell,
+            self.origin[1] + self.ny as f64 * self.cell,
+        ];
+        (self.origin, hi)
+    }
+
+    /// The box of cells around `cells` (cell indices) grown by one cell on each side and
+    /// clipped to the grid, as index ranges `(i_range, j_range)`: the cells and every
+    /// neighbour of theirs. `None` when `cells` is empty.
+    ///
+    /// ```
+    /// let grid = nadf::field::Grid::covering([1.0, 1.0], 0.1);
+    /// let (i, j) = grid.box_around([grid.index(0, 4), grid.index(3, 5)]).unwrap();
+    /// assert_eq!((i, j), (0..5, 3..7));
+    /// assert!(grid.box_around([]).is_none());
+    /// ```
+    pub fn box_around(
+        &self,
+        cells: impl IntoIterator<Item = usize>,
+    ) -> Option<(std::ops::Range<usize>, std::ops::Range<usize>)> {
+        let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
+        for k in cells {
+            let (i, j) = (k % self.nx, k / self.nx);
+            lo = [lo[0].min(i), lo[1].min(j)];
+            hi = [hi[0].max(i), hi[1].max(j)];
+        }
+        (lo[0] != usize::MAX).then(|| {
+            (
+                lo[0].saturating_sub(1)..(hi[0] + 2).min(self.nx),
+                lo[1].saturating_sub(1)..(hi[1] + 2).min(self.ny),
+            )
+        })
+    }
+
     /// The part of this grid made of the cells `i` along x and `j` along y: the same cells,
     /// numbered from the part's corner (a window, a box around some cells).
     ///

@@ -215,9 +215,7 @@ impl HarmonicField {
         others: &[Disc],
         settings: &FieldSettings,
     ) -> Option<Result<Self, FieldError>> {
-        let grid = self.grid();
-        let (lo, reach) = (grid.origin, settings.replan_reach);
-        let hi = [0, 1].map(|a| lo[a] + grid.cell * [grid.nx, grid.ny][a] as f64);
+        let ((lo, hi), reach) = (self.grid().bounds(), settings.replan_reach);
         let covered = (0..2).all(|a| position[a] - reach <= lo[a] && position[a] + reach >= hi[a]);
         (!covered).then(|| self.windowed(agent, position, others, settings, Reach::Whole))
     }

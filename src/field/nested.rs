@@ -467,15 +467,9 @@ impl Levels<'_> {
     /// Solves a wide part by multigrid on its bounding box, at the scale `2^scale`.
     fn solve_wide(&self, cells: &[usize], scale: i32) -> Solved {
         let g = self.grid;
-        let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
-        for &k in cells {
-            let (i, j) = (k % g.nx, k / g.nx);
-            lo = [lo[0].min(i), lo[1].min(j)];
-            hi = [hi[0].max(i), hi[1].max(j)];
-        }
-        let (i0, j0) = (lo[0].saturating_sub(1), lo[1].saturating_sub(1));
-        let (i1, j1) = ((hi[0] + 1).min(g.nx - 1), (hi[1] + 1).min(g.ny - 1));
-        let sub = g.part(i0..i1 + 1, j0..j1 + 1);
+        let (ir, jr) = (g.box_around(cells.iter().copied())).expect("a part has cells");
+        let (i0, j0) = (ir.start, jr.start);
+        let sub = g.part(ir, jr);
         let local = |k: usize| sub.index(k % g.nx - i0, k / g.nx - j0);
         let mut unknown = vec![false; sub.len()];
         for &k in cells {

@@ -324,11 +324,7 @@ fn coarse_problem(
     discs: &[Disc],
 ) -> Problem {
     let cell = grid.cell * COARSE as f64;
-    let lo = [grid.origin[0], grid.origin[1]];
-    let hi = [
-        grid.origin[0] + grid.nx as f64 * grid.cell,
-        grid.origin[1] + grid.ny as f64 * grid.cell,
-    ];
+    let (lo, hi) = grid.bounds();
     let from = [
         (position[0] - reach).max(lo[0]),
         (position[1] - reach).max(lo[1]),

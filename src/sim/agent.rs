@@ -680,7 +680,7 @@ impl AgentRun {
             } else if others.is_empty() {
                 Ok(walls.without_window())
             } else {
-                match walls.with_window(&self.agent, plan.x.into(), others, &world.field) {
+                match walls.with_window(&self.agent, x, others, &world.field) {
                     Err(FieldError::Unreachable { .. }) => whole_among_others(others),
                     // A window whose guidance at the agent turns back on the last field's:
                     // the window moved with the agent and the field of the walls on its edge

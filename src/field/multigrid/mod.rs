@@ -120,17 +120,8 @@ impl Crop {
     /// The box of `grid` around its `unknown` cells, if it is at most half the grid (and not
     /// empty).
     fn of(grid: &Grid, unknown: &[bool]) -> Option<Self> {
-        let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
-        for (k, _) in unknown.iter().enumerate().filter(|(_, u)| **u) {
-            let (i, j) = (k % grid.nx, k / grid.nx);
-            lo = [lo[0].min(i), lo[1].min(j)];
-            hi = [hi[0].max(i), hi[1].max(j)];
-        }
-        if lo[0] == usize::MAX {
-            return None;
-        }
-        let i = lo[0].saturating_sub(1)..(hi[0] + 2).min(grid.nx);
-        let j = lo[1].saturating_sub(1)..(hi[1] + 2).min(grid.ny);
+        let cells = (unknown.iter().enumerate()).filter_map(|(k, u)| u.then_some(k));
+        let (i, j) = grid.box_around(cells)?;
         (2 * i.len() * j.len() <= grid.len()).then_some(Self { i, j })
     }
 
