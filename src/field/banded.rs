@@ -21,24 +21,11 @@ pub fn solve(neighbours: &[Neighbours], rhs: &[f64], max_band: usize) -> Option<
     if n == 0 {
         return Some(Vec::new());
     }
-    let order = reverse_cuthill_mckee(neighbours);
-    let mut position = vec![0usize; n];
-    for (p, &k) in order.iter().enumerate() {
-        position[k] = p;
-    }
-    let band = (0..n)
-        .flat_map(|k| {
-            let position = &position;
-            neighbours[k]
-                .iter()
-                .filter(|&&m| m != u32::MAX)
-                .map(move |&m| position[k].abs_diff(position[m as usize]))
-        })
-        .max()
-        .unwrap_or(0);
-    if band > max_band {
-        return None;
-    }
+    let Banded {
+        order,
+        position,
+        band,
+    } = reverse_cuthill_mckee(neighbours, max_band)?;
     let b = band.max(1);
     // l[p * b + (p − q − 1)] = L[p][q] for q in p − b .. p; a[…] the same of the matrix.
     let mut l = vec![0.0; n * b];
@@ -93,45 +80,96 @@ pub fn solve(neighbours: &[Neighbours], rhs: &[f64], max_band: usize) -> Option<
     Some(u)
 }
 
+/// A part's cells in band order.
+struct Banded {
+    /// The cells in order.
+    order: Vec<usize>,
+    /// Each cell's place in `order`.
+    position: Vec<usize>,
+    /// The largest distance in `order` between two neighbours.
+    band: usize,
+}
+
 /// The cells in reverse Cuthill–McKee order: breadth-first from a pseudo-peripheral cell (the
-/// last one reached from the first cell), neighbours by increasing degree, then reversed.
-fn reverse_cuthill_mckee(neighbours: &[Neighbours]) -> Vec<usize> {
+/// last one reached from the first cell), neighbours by increasing degree, then reversed; `None`
+/// as soon as its band is known to exceed `max_band`.
+///
+/// A wide region is refused within a few thousand cells, not after two passes over all of it
+/// (the nested levels offer every part here first, and a room's is a hundred thousand cells):
+/// - in any order of band `b`, the cells within `d` steps of a cell lie within `b · d` places of
+///   it, so a search that finds more than `2 b d + 1` of them proves every order's band wider;
+/// - in the second search the order is the final one (reversed, which keeps the band), and
+///   every pair of neighbours has its places once the first of them is visited, so the band is
+///   known exactly as the search goes.
+fn reverse_cuthill_mckee(neighbours: &[Neighbours], max_band: usize) -> Option<Banded> {
     let n = neighbours.len();
     let degree = |k: usize| neighbours[k].iter().filter(|&&m| m != u32::MAX).count();
-    let breadth_first = |start: usize| {
-        let mut seen = vec![false; n];
+    let mut position = vec![usize::MAX; n];
+    // The order from `start` and its band (exact when `track`), or `None` past `max_band`.
+    let mut breadth_first = |start: usize, track: bool| {
+        position.fill(usize::MAX);
         let mut order = Vec::with_capacity(n);
-        seen[start] = true;
+        position[start] = 0;
         order.push(start);
-        let mut head = 0;
+        let (mut head, mut band) = (0, 0);
+        // The cells within `depth` steps are `order[..reached]`, while the part is connected.
+        let (mut depth, mut reached, mut connected) = (0, 1, true);
         while head < order.len() {
             let k = order[head];
             head += 1;
-            let mut next: Vec<usize> = neighbours[k]
-                .iter()
-                .filter(|&&m| m != u32::MAX && !seen[m as usize])
-                .map(|&m| m as usize)
-                .collect();
-            next.sort_by_key(|&m| (degree(m), m));
-            for m in next {
-                seen[m] = true;
+            let mut next = [(usize::MAX, usize::MAX); 4];
+            let mut count = 0;
+            for &m in neighbours[k].iter().filter(|&&m| m != u32::MAX) {
+                if position[m as usize] == usize::MAX {
+                    next[count] = (degree(m as usize), m as usize);
+                    count += 1;
+                }
+            }
+            next[..count].sort_unstable();
+            for &(_, m) in &next[..count] {
+                position[m] = order.len();
                 order.push(m);
+            }
+            if track {
+                for &m in neighbours[k].iter().filter(|&&m| m != u32::MAX) {
+                    band = band.max(position[m as usize].abs_diff(head - 1));
+                }
+                if band > max_band {
+                    return None;
+                }
+            }
+            if connected && head == reached {
+                // Every cell within `depth` steps is visited: `order` holds those within
+                // `depth + 1`.
+                (depth, reached) = (depth + 1, order.len());
+                if reached > max_band.saturating_mul(2 * depth).saturating_add(1) {
+                    return None;
+                }
             }
             // A part is connected; should it not be, the rest follows from its first cell.
             if head == order.len()
                 && order.len() < n
-                && let Some(rest) = (0..n).find(|&m| !seen[m])
+                && let Some(rest) = (0..n).find(|&m| position[m] == usize::MAX)
             {
-                seen[rest] = true;
+                position[rest] = order.len();
                 order.push(rest);
+                connected = false;
             }
         }
-        order
+        Some((order, band))
     };
-    let far = *breadth_first(0).last().expect("a cell");
-    let mut order = breadth_first(far);
+    let (first, _) = breadth_first(0, false)?;
+    let far = *first.last().expect("a cell");
+    let (mut order, band) = breadth_first(far, true)?;
     order.reverse();
-    order
+    for (p, &k) in order.iter().enumerate() {
+        position[k] = p;
+    }
+    Some(Banded {
+        order,
+        position,
+        band,
+    })
 }
 
 #[cfg(test)]
@@ -196,5 +234,68 @@ mod tests {
             assert!((4.0 * u[k] - sum - rhs[k]).abs() < 1e-12, "cell {k}");
         }
         assert!(solve(&corridor(60, 40), &vec![1.0; 2400], 16).is_none());
+    }
+
+    /// Refusing early never refuses a part whose order fits: for corridors of every width and a
+    /// comb (teeth one cell wide off a spine), `solve` succeeds exactly when the band of the
+    /// full ordering is at most `max_band`.
+    #[test]
+    fn a_part_is_refused_exactly_when_its_band_is_too_wide() {
+        let mut shapes: Vec<Vec<Neighbours>> = (1..12).map(|w| corridor(40, w)).collect();
+        // A comb: a spine along j = 0 of 30 cells, a tooth of 6 cells up from every other one.
+        let cell = |i: usize, j: usize| (j == 0 || i.is_multiple_of(2)).then_some(j * 30 + i);
+        let cells: Vec<(usize, usize)> = (0..7)
+            .flat_map(|j| (0..30).map(move |i| (i, j)))
+            .filter(|&(i, j)| cell(i, j).is_some())
+            .collect();
+        let local = |i: usize, j: usize| {
+            cell(i, j).and_then(|c| cells.iter().position(|&(a, b)| b * 30 + a == c))
+        };
+        shapes.push(
+            cells
+                .iter()
+                .map(|&(i, j)| {
+                    let at = |a: Option<usize>, b: Option<usize>| match (a, b) {
+                        (Some(a), Some(b)) if a < 30 && b < 7 => local(a, b),
+                        _ => None,
+                    };
+                    [
+                        at(i.checked_sub(1), Some(j)),
+                        at(Some(i + 1), Some(j)),
+                        at(Some(i), j.checked_sub(1)),
+                        at(Some(i), Some(j + 1)),
+                    ]
+                    .map(|m| m.map_or(u32::MAX, |m| m as u32))
+                })
+                .collect(),
+        );
+        // A path of 41 cells numbered from its middle: the search from its first cell meets
+        // the bound's limit at every step (2 d + 1 cells within d steps, band 1).
+        let at = |i: usize| (i as u32 + 21) % 41;
+        shapes.push(
+            (0..41)
+                .map(|k| (k + 20) % 41)
+                .map(|i| {
+                    [
+                        if i > 0 { at(i - 1) } else { u32::MAX },
+                        if i < 40 { at(i + 1) } else { u32::MAX },
+                        u32::MAX,
+                        u32::MAX,
+                    ]
+                })
+                .collect(),
+        );
+        for nb in &shapes {
+            let band = reverse_cuthill_mckee(nb, usize::MAX).unwrap().band;
+            let rhs = vec![1.0; nb.len()];
+            for max_band in 0..band + 3 {
+                assert_eq!(
+                    solve(nb, &rhs, max_band).is_some(),
+                    band <= max_band,
+                    "{} cells, band {band}, max {max_band}",
+                    nb.len()
+                );
+            }
+        }
     }
 }
