@@ -60,16 +60,20 @@ pub struct HarmonicField {
 }
 
 impl HarmonicField {
-    /// Rasterizes the world for `agent` and solves its field.
+    /// Rasterizes the world for `agent` and solves its field, to every cell however deep (the
+    /// field `nadf field` exports and draws).
     pub fn solve(world: &World, agent: &Agent) -> Result<Self, FieldError> {
         let started = Instant::now();
         let space = FreeSpace::of(world, agent)?;
-        Self::solve_space(world, agent, space, None, started)
+        Self::solve_space(world, agent, space, (None, None), started)
     }
 
     /// Solves the field with the agent at `position`, the walls sensed with `offsets` and the
     /// discs `others` (the other agents) as obstacles too (see [`FreeSpace::among`]),
-    /// warm-started from `previous` (the last field, on the same grid).
+    /// warm-started from `previous` (the last field, on the same grid). A field of any depth is
+    /// solved only to [`BELOW_AGENT`](super::BELOW_AGENT) of `W` at `position` (the cells
+    /// beyond are 0: see [`solve_w_for`](super::solvers::solve_w_for));
+    /// [`HarmonicField::solve`] solves every cell.
     pub fn solve_among(
         world: &World,
         agent: &Agent,
@@ -81,7 +85,13 @@ impl HarmonicField {
         let started = Instant::now();
         let space = FreeSpace::among(world, agent, position, offsets, others)?;
         let warm = previous.map(|f| f.sampler.values().to_plain());
-        Self::solve_space(world, agent, space, warm.as_deref(), started)
+        Self::solve_space(
+            world,
+            agent,
+            space,
+            (warm.as_deref(), Some(position)),
+            started,
+        )
     }
 
     /// Solves the field of a lidar agent at `position` on the map it has built (see
@@ -97,23 +107,32 @@ impl HarmonicField {
         let started = Instant::now();
         let space = FreeSpace::known(world, agent, position, known, others)?;
         let warm = previous.map(|f| f.sampler.values().to_plain());
-        Self::solve_space(world, agent, space, warm.as_deref(), started)
+        Self::solve_space(
+            world,
+            agent,
+            space,
+            (warm.as_deref(), Some(position)),
+            started,
+        )
     }
 
-    /// Solves the field of `space` for `agent` (warm-started from `warm`, timed from `started`).
+    /// Solves the field of `space` for `agent` (warm-started from `warm`, timed from `started`):
+    /// for the agent at `at`, if given, only as deep as it can use (see [`solve_w_for`]).
     pub(super) fn solve_space(
         world: &World,
         agent: &Agent,
         space: FreeSpace,
-        warm: Option<&[f64]>,
+        (warm, at): (Option<&[f64]>, Option<[f64; 2]>),
         started: Instant,
     ) -> Result<Self, FieldError> {
-        let solution = solve_w(
-            &space.grid,
-            &space.reachable,
-            &space.target_cells,
+        let grid = &space.grid;
+        let solution = solve_w_for(
+            grid,
+            (&space.reachable, &space.target_cells),
             world.field.tolerance,
             warm,
+            at.and_then(|p| grid.cell_of(p))
+                .map(|(i, j)| grid.index(i, j)),
         );
         if solution.relative_residual.is_nan() || solution.relative_residual > world.field.tolerance
         {
@@ -423,6 +442,22 @@ pub fn solve_w(
     tolerance: f64,
     warm: Option<&[f64]>,
 ) -> HarmonicSolution {
+    solve_w_for(grid, (reachable, target), tolerance, warm, None)
+}
+
+/// [`solve_w`] for an agent at cell `agent`, if any: the nested levels stop once every cell
+/// left is below [`BELOW_AGENT`](super::BELOW_AGENT) of `W` there, and leave those cells at 0.
+/// Every cell kept is [`solve_w`]'s to the bit (the levels run alike until they stop, and only
+/// ever write cells not yet accepted), and none left out is above the bound (the cells not yet
+/// accepted are bounded by the largest `W` on the accepted cells around them: the maximum
+/// principle).
+pub fn solve_w_for(
+    grid: &Grid,
+    (reachable, target): (&[bool], &[usize]),
+    tolerance: f64,
+    warm: Option<&[f64]>,
+    agent: Option<usize>,
+) -> HarmonicSolution {
     let mut unknown = reachable.to_vec();
     for &t in target {
         unknown[t] = false;
@@ -441,7 +476,7 @@ pub fn solve_w(
     let first = multigrid::solve(grid, &unknown, &mut w, tolerance, MAX_ITERATIONS);
     let pending = deep_cells(grid, &unknown, &w, DEPTH_STEP);
     let mut w = ScaledW::from_plain(w);
-    let nested = solve_levels(grid, pending, &mut w, tolerance);
+    let nested = solve_levels(grid, pending, &mut w, tolerance, agent);
     HarmonicSolution {
         w,
         iterations: first.iterations + nested.iterations,

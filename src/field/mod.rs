@@ -52,7 +52,7 @@ pub use joint_field::{JointField, JointTarget};
 pub use joint_mask::{JointAxis, JointMask, segment_distance};
 pub use known::{Beam, KnownMap};
 pub use mask::{CellCounts, Disc, FreeSpace};
-pub use nested::LevelStats;
+pub use nested::{BELOW_AGENT, LevelStats};
 pub use pose::{Pose, PoseField, angle_difference};
 pub use sample::Sampler;
 pub use scaled::ScaledW;
@@ -64,7 +64,7 @@ pub use yielding::{CLEAR_OF_WAY, IN_THE_WAY, WAY_AHEAD, Way};
 /// The solver's internals, public for the benchmarks only: not part of the crate's API.
 #[doc(hidden)]
 pub mod solvers {
-    pub use super::harmonic::solve_w;
+    pub use super::harmonic::{solve_w, solve_w_for};
     pub use super::laplace::solve_sor;
     pub use super::multigrid::{set_portable, solve};
     pub use super::nested::MAX_ITERATIONS;

@@ -90,6 +90,13 @@ pub const LEVEL_RANGE: f64 = 1e-12;
 pub const GAP: f64 = 1e3;
 /// CG iterations allowed per solve.
 pub const MAX_ITERATIONS: usize = 500;
+/// How far below `W` at the agent a field solved for a run is carried: once every pending cell
+/// is below this fraction of it, the levels stop and leave those cells at 0 (see
+/// `solve_levels`). The guidance leads up `W`, and a body strays from its kinematic path by
+/// about `m v / B_d`, under a metre; fifty decades lie far behind it (on the Moving AI rooms map
+/// about a room back, through its one-cell door; in a corridor one cell wide, 87 cells). A
+/// field exported or drawn on its own (`nadf field`) is solved to every cell.
+pub const BELOW_AGENT: f64 = 1e-50;
 /// The widest band a part may have to be solved directly (`banded.rs`) rather than by
 /// multigrid: a few corridors side by side.
 pub const MAX_BAND: usize = 48;
@@ -107,6 +114,9 @@ pub struct LevelStats {
     pub relative_residual: f64,
     /// Cells solved, summed over the solves (a cell solved in three levels counts three times).
     pub cells_solved: usize,
+    /// Reachable cells left at `W = 0`, all below [`BELOW_AGENT`] of `W` at the agent the field
+    /// was solved for (0 when solved to every cell).
+    pub left: usize,
 }
 
 /// The cells below `depth` that need a nested solve: those more than [`REACH`] steps through
@@ -203,11 +213,19 @@ struct Levels<'a> {
 
 /// Runs the nested levels on `w` (the first solve's values, exponent 0) until every cell is
 /// accepted; `pending` are the cells the first solve did not resolve.
+///
+/// With `agent` (the cell of the agent the field is for), they stop once that cell is accepted
+/// and every pending cell is below [`BELOW_AGENT`] of it, and leave those cells at 0. Every cell
+/// kept is the full solve's to the bit (the levels run alike until then, and only ever write
+/// pending cells), and none left out is above the bound: the pending cells are bounded by the
+/// accepted cells around them and the walls' 0, so by the largest `W` on the frontier (the
+/// maximum principle), and the levels stop only when that is below it.
 pub fn solve_levels(
     grid: &Grid,
     pending: Vec<bool>,
     w: &mut ScaledW,
     tolerance: f64,
+    agent: Option<usize>,
 ) -> LevelStats {
     let n = grid.len();
     let mut levels = Levels {
@@ -234,6 +252,10 @@ pub fn solve_levels(
         }
     }
     while !levels.frontier.is_empty() {
+        if agent.is_some_and(|k| levels.deep_enough(k)) {
+            levels.leave_the_rest();
+            break;
+        }
         levels.run_level();
     }
     levels.stats
@@ -253,6 +275,38 @@ impl Levels<'_> {
         !self.pending[k] && self.w.mantissa[k] > 0.0
     }
 
+    /// `log2` of the largest `W` on the frontier: every pending cell is below it.
+    fn top(&self) -> f64 {
+        self.frontier
+            .iter()
+            .map(|&k| self.w.log2(k))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Whether the agent's cell `k` is accepted and every pending cell is below
+    /// [`BELOW_AGENT`] of it.
+    fn deep_enough(&self, k: usize) -> bool {
+        self.accepted(k) && self.top() < self.w.log2(k) + BELOW_AGENT.log2()
+    }
+
+    /// Leaves every pending cell at 0, at the scale of the deepest frontier cell (so that no
+    /// sample near them is taken at a larger scale than their accepted neighbours').
+    fn leave_the_rest(&mut self) {
+        let deepest = (self.frontier.iter())
+            .map(|&k| self.w.exponent[k])
+            .min()
+            .unwrap_or(0);
+        for k in 0..self.pending.len() {
+            if self.pending[k] {
+                self.pending[k] = false;
+                self.w.mantissa[k] = 0.0;
+                self.w.exponent[k] = deepest;
+                self.stats.left += 1;
+            }
+        }
+        self.frontier.clear();
+    }
+
     /// One level: the band, its parts solved, their resolved cells accepted.
     fn run_level(&mut self) {
         self.level += 1;
@@ -260,11 +314,7 @@ impl Levels<'_> {
         // This level works from the frontier cells within LEVEL_RANGE of the largest, and
         // accepts nothing below GAP times that: cells are accepted in order of decreasing `W`,
         // a few decades per level, so a cut never lies where a larger `W` still flows in.
-        let top = self
-            .frontier
-            .iter()
-            .map(|&k| self.w.log2(k))
-            .fold(f64::NEG_INFINITY, f64::max);
+        let top = self.top();
         let lowest = top + LEVEL_RANGE.log2();
         let band = self.band_cells(lowest);
         let parts = self.parts(&band);
@@ -579,9 +629,10 @@ mod tests {
     /// A serpentine corridor one cell wide, 20,000 cells long: `W` falls by 2 − √3 per cell,
     /// to about 1e-11400 at its end, far below f64. Every cell gets a positive `W` at its
     /// scale, the decay per cell is the corridor's, and the field is harmonic everywhere.
-    #[test]
-    fn a_corridor_far_deeper_than_f64_keeps_its_decay_to_the_end() {
-        let n = 201;
+    /// A serpentine corridor one cell wide in an `n × n` grid of 1 m cells: the grid, its
+    /// blocked cells, the cells reachable from the target `(1, 1)`, and the corridor's cells in
+    /// order from the target.
+    fn serpentine(n: usize) -> (Grid, Vec<bool>, Vec<bool>, Vec<usize>) {
         let grid = Grid::covering([n as f64, n as f64], 1.0);
         let mut blocked = vec![true; grid.len()];
         // Rows 1, 3, 5, … are free; they connect at alternate ends.
@@ -594,11 +645,7 @@ mod tests {
                 blocked[grid.index(end, j + 1)] = false;
             }
         }
-        let target = (1, 1);
-        let reachable = reachable_from(&grid, &blocked, target);
-        let s = solve_from_cell(&grid, &blocked, target);
-        let w = &s.w;
-        // Walk the corridor from the target.
+        let reachable = reachable_from(&grid, &blocked, (1, 1));
         let mut path = vec![grid.index(1, 1)];
         let mut seen = vec![false; grid.len()];
         seen[path[0]] = true;
@@ -609,6 +656,15 @@ mod tests {
             seen[next] = true;
             path.push(next);
         }
+        (grid, blocked, reachable, path)
+    }
+
+    #[test]
+    fn a_corridor_far_deeper_than_f64_keeps_its_decay_to_the_end() {
+        let n = 201;
+        let (grid, blocked, reachable, path) = serpentine(n);
+        let s = solve_from_cell(&grid, &blocked, (1, 1));
+        let w = &s.w;
         assert!(path.len() > 19_000, "{}", path.len());
         let end = *path.last().unwrap();
         assert!(w.log10(end) < -10_000.0, "{}", w.log10(end));
@@ -637,5 +693,49 @@ mod tests {
         }
         // The solved cells: a few times the corridor, not levels × corridor.
         assert!(s.nested.cells_solved < 5 * path.len(), "{:?}", s.nested);
+    }
+
+    /// A field solved for an agent 2,000 cells down the serpentine (`W` about 1e-1144) keeps
+    /// every cell it solves to the bit of the full solve, leaves only cells more than
+    /// [`BELOW_AGENT`] below the agent, and solves far fewer.
+    #[test]
+    fn a_field_for_an_agent_stops_below_it() {
+        let (grid, blocked, reachable, path) = serpentine(101);
+        let target = [grid.index(1, 1)];
+        let full = solve_from_cell(&grid, &blocked, (1, 1));
+        let agent = path[2_000];
+        let cut = crate::field::harmonic::solve_w_for(
+            &grid,
+            (&reachable, &target),
+            1e-12,
+            None,
+            Some(agent),
+        );
+        assert_eq!(full.nested.left, 0);
+        assert!(cut.nested.left > 2_000, "{:?}", cut.nested);
+        assert!(
+            2 * cut.nested.cells_solved < full.nested.cells_solved,
+            "{:?} against {:?}",
+            cut.nested,
+            full.nested
+        );
+        let below = full.w.log10(agent) + BELOW_AGENT.log10();
+        let mut kept = 0;
+        for k in (0..grid.len()).filter(|&k| reachable[k]) {
+            if cut.w.mantissa[k] > 0.0 {
+                kept += 1;
+                assert_eq!(cut.w.mantissa[k], full.w.mantissa[k], "cell {k}");
+                assert_eq!(cut.w.exponent[k], full.w.exponent[k], "cell {k}");
+            } else {
+                assert!(full.w.log10(k) < below, "cell {k}: {}", full.w.log10(k));
+            }
+        }
+        assert_eq!(
+            kept + cut.nested.left,
+            reachable.iter().filter(|r| **r).count()
+        );
+        // Everything between the agent and the target is kept, and 80 cells beyond it (46
+        // decades; the bound's 50 are 87 cells of this corridor).
+        assert!(path[..2_080].iter().all(|&k| cut.w.mantissa[k] > 0.0));
     }
 }

@@ -446,7 +446,7 @@ fn solve_problem(
             scaled.exponent[k] = 0;
         }
     }
-    let nested = solve_levels(&local, pending, &mut scaled, tolerance);
+    let nested = solve_levels(&local, pending, &mut scaled, tolerance, None);
     Ok((
         Sampler::new(local, scaled, connected),
         stats.iterations + nested.iterations,

@@ -190,7 +190,7 @@ impl HarmonicField {
                     radius: agent.radius,
                 }
             })?;
-        Self::solve_space(world, agent, space, None, started)
+        Self::solve_space(world, agent, space, (None, None), started)
     }
 }
 

@@ -27,10 +27,14 @@ pub fn potential_image(field: &HarmonicField) -> (Vec<u8>, [u32; 2]) {
         .fold(0.0_f64, f64::min);
     let mut rgb = Vec::with_capacity(grid.len() * 3);
     for (k, &l) in logs.iter().enumerate() {
+        // A reachable cell at `W = 0` lies deeper than its run needed it solved (see
+        // `HarmonicField::solve_among`): it takes the deepest colour.
         let colour = if field.blocked[k] {
             BLOCKED
-        } else if !l.is_finite() {
+        } else if l.is_nan() {
             UNREACHABLE
+        } else if l == f64::NEG_INFINITY {
+            viridis(0.0)
         } else {
             let t = if lo < 0.0 { 1.0 - l / lo } else { 1.0 };
             viridis(t)
