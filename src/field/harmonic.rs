@@ -84,18 +84,12 @@ impl HarmonicField {
     ) -> Result<Self, FieldError> {
         let started = Instant::now();
         let space = FreeSpace::among(world, agent, position, offsets, others)?;
-        let warm = previous.map(|f| f.sampler.values().to_plain());
-        Self::solve_space(
-            world,
-            agent,
-            space,
-            (warm.as_deref(), Some(position)),
-            started,
-        )
+        Self::solve_at(world, agent, space, (position, previous), started)
     }
 
     /// Solves the field of a lidar agent at `position` on the map it has built (see
-    /// [`FreeSpace::known`]), warm-started from `previous`.
+    /// [`FreeSpace::known`]), warm-started from `previous`, as deep as
+    /// [`HarmonicField::solve_among`] solves.
     pub fn solve_known(
         world: &World,
         agent: &Agent,
@@ -106,6 +100,18 @@ impl HarmonicField {
     ) -> Result<Self, FieldError> {
         let started = Instant::now();
         let space = FreeSpace::known(world, agent, position, known, others)?;
+        Self::solve_at(world, agent, space, (position, previous), started)
+    }
+
+    /// Solves the field of `space` for `agent` at `position`, as deep as it can use,
+    /// warm-started from `previous` (timed from `started`).
+    fn solve_at(
+        world: &World,
+        agent: &Agent,
+        space: FreeSpace,
+        (position, previous): ([f64; 2], Option<&HarmonicField>),
+        started: Instant,
+    ) -> Result<Self, FieldError> {
         let warm = previous.map(|f| f.sampler.values().to_plain());
         Self::solve_space(
             world,
