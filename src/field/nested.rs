@@ -252,11 +252,12 @@ pub fn solve_levels(
         }
     }
     while !levels.frontier.is_empty() {
-        if agent.is_some_and(|k| levels.deep_enough(k)) {
+        let top = levels.top();
+        if agent.is_some_and(|k| levels.deep_enough(k, top)) {
             levels.leave_the_rest();
             break;
         }
-        levels.run_level();
+        levels.run_level(top);
     }
     levels.stats
 }
@@ -284,9 +285,9 @@ impl Levels<'_> {
     }
 
     /// Whether the agent's cell `k` is accepted and every pending cell is below
-    /// [`BELOW_AGENT`] of it.
-    fn deep_enough(&self, k: usize) -> bool {
-        self.accepted(k) && self.top() < self.w.log2(k) + BELOW_AGENT.log2()
+    /// [`BELOW_AGENT`] of it (`top`: the frontier's [`Levels::top`]).
+    fn deep_enough(&self, k: usize, top: f64) -> bool {
+        self.accepted(k) && top < self.w.log2(k) + BELOW_AGENT.log2()
     }
 
     /// Leaves every pending cell at 0, at the scale of the deepest frontier cell (so that no
@@ -307,14 +308,14 @@ impl Levels<'_> {
         self.frontier.clear();
     }
 
-    /// One level: the band, its parts solved, their resolved cells accepted.
-    fn run_level(&mut self) {
+    /// One level: the band, its parts solved, their resolved cells accepted (`top`: the
+    /// frontier's [`Levels::top`]).
+    fn run_level(&mut self, top: f64) {
         self.level += 1;
         self.stats.levels += 1;
         // This level works from the frontier cells within LEVEL_RANGE of the largest, and
         // accepts nothing below GAP times that: cells are accepted in order of decreasing `W`,
         // a few decades per level, so a cut never lies where a larger `W` still flows in.
-        let top = self.top();
         let lowest = top + LEVEL_RANGE.log2();
         let band = self.band_cells(lowest);
         let parts = self.parts(&band);
@@ -626,9 +627,6 @@ mod tests {
     use crate::field::harmonic::solve_from_cell;
     use crate::field::laplace::reachable_from;
 
-    /// A serpentine corridor one cell wide, 20,000 cells long: `W` falls by 2 − √3 per cell,
-    /// to about 1e-11400 at its end, far below f64. Every cell gets a positive `W` at its
-    /// scale, the decay per cell is the corridor's, and the field is harmonic everywhere.
     /// A serpentine corridor one cell wide in an `n × n` grid of 1 m cells: the grid, its
     /// blocked cells, the cells reachable from the target `(1, 1)`, and the corridor's cells in
     /// order from the target.
@@ -659,6 +657,9 @@ mod tests {
         (grid, blocked, reachable, path)
     }
 
+    /// A serpentine corridor one cell wide, 20,000 cells long: `W` falls by 2 − √3 per cell,
+    /// to about 1e-11400 at its end, far below f64. Every cell gets a positive `W` at its
+    /// scale, the decay per cell is the corridor's, and the field is harmonic everywhere.
     #[test]
     fn a_corridor_far_deeper_than_f64_keeps_its_decay_to_the_end() {
         let n = 201;
