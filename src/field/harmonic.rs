@@ -18,7 +18,7 @@ use nalgebra::Vector2;
 use super::grid::Grid;
 use super::mask::CellCounts;
 use super::multigrid;
-use super::nested::{DEPTH_STEP, LevelStats, MAX_ITERATIONS, deep_cells, solve_levels};
+use super::nested::{DEPTH_STEP, LevelStats, MAX_ITERATIONS, Stop, deep_cells, solve_levels};
 use super::scaled::{ScaledW, ldexp};
 use super::window::{Reach, Window};
 use super::{Disc, FieldError, FreeSpace, KnownMap, Sampler, Streamline};
@@ -482,7 +482,8 @@ pub fn solve_w_for(
     let first = multigrid::solve(grid, &unknown, &mut w, tolerance, MAX_ITERATIONS);
     let pending = deep_cells(grid, &unknown, &w, DEPTH_STEP);
     let mut w = ScaledW::from_plain(w);
-    let nested = solve_levels(grid, pending, &mut w, tolerance, agent);
+    let stop = agent.map_or(Stop::Never, Stop::BelowAgent);
+    let nested = solve_levels(grid, pending, &mut w, tolerance, &stop);
     HarmonicSolution {
         w,
         iterations: first.iterations + nested.iterations,

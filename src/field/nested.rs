@@ -211,21 +211,32 @@ struct Levels<'a> {
     stats: LevelStats,
 }
 
+/// When the nested levels may stop before every reachable cell is accepted, leaving the cells
+/// still pending at 0. Whatever the rule, every cell kept is the full solve's to the bit: the
+/// levels run alike until they stop, and only ever write pending cells.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Stop {
+    /// Never: every reachable cell is solved (a field exported or drawn on its own).
+    Never,
+    /// For an agent at this cell: once it is accepted and every pending cell is below
+    /// [`BELOW_AGENT`] of it. None left out is above the bound: the pending cells are bounded
+    /// by the accepted cells around them and the walls' 0, so by the largest `W` on the
+    /// frontier (the maximum principle), and the levels stop only when that is below it.
+    BelowAgent(usize),
+    /// Once every cell of this box (cell index ranges along x and y) is accepted: a field read
+    /// only there (a coarse window, which gives the rings of the fine windows near its centre).
+    Within(std::ops::Range<usize>, std::ops::Range<usize>),
+}
+
 /// Runs the nested levels on `w` (the first solve's values, exponent 0) until every cell is
-/// accepted; `pending` are the cells the first solve did not resolve.
-///
-/// With `agent` (the cell of the agent the field is for), they stop once that cell is accepted
-/// and every pending cell is below [`BELOW_AGENT`] of it, and leave those cells at 0. Every cell
-/// kept is the full solve's to the bit (the levels run alike until then, and only ever write
-/// pending cells), and none left out is above the bound: the pending cells are bounded by the
-/// accepted cells around them and the walls' 0, so by the largest `W` on the frontier (the
-/// maximum principle), and the levels stop only when that is below it.
+/// accepted, or until `stop` allows; `pending` are the cells the first solve did not resolve.
+/// The cells still pending then are left at 0 (counted in [`LevelStats::left`]).
 pub fn solve_levels(
     grid: &Grid,
     pending: Vec<bool>,
     w: &mut ScaledW,
     tolerance: f64,
-    agent: Option<usize>,
+    stop: &Stop,
 ) -> LevelStats {
     let n = grid.len();
     let mut levels = Levels {
@@ -251,13 +262,32 @@ pub fn solve_levels(
             levels.frontier.push(k);
         }
     }
+    // The pending cells of the box a `Stop::Within` keeps.
+    let in_box = |k: usize| match stop {
+        Stop::Within(i, j) => i.contains(&(k % grid.nx)) && j.contains(&(k / grid.nx)),
+        _ => false,
+    };
+    let mut in_box_pending = match stop {
+        Stop::Within(i, j) => j
+            .clone()
+            .flat_map(|j| i.clone().map(move |i| grid.index(i, j)))
+            .filter(|&k| levels.pending[k])
+            .count(),
+        _ => 0,
+    };
     while !levels.frontier.is_empty() {
         let top = levels.top();
-        if agent.is_some_and(|k| levels.deep_enough(k, top)) {
+        let done = match stop {
+            Stop::Never => false,
+            Stop::BelowAgent(k) => levels.deep_enough(*k, top),
+            Stop::Within(..) => in_box_pending == 0,
+        };
+        if done {
             levels.leave_the_rest();
             break;
         }
-        levels.run_level(top);
+        let accepted = levels.run_level(top);
+        in_box_pending -= accepted.iter().filter(|&&k| in_box(k)).count();
     }
     levels.stats
 }
@@ -309,8 +339,8 @@ impl Levels<'_> {
     }
 
     /// One level: the band, its parts solved, their resolved cells accepted (`top`: the
-    /// frontier's [`Levels::top`]).
-    fn run_level(&mut self, top: f64) {
+    /// frontier's [`Levels::top`]). Returns the cells it accepted.
+    fn run_level(&mut self, top: f64) -> Vec<usize> {
         self.level += 1;
         self.stats.levels += 1;
         // This level works from the frontier cells within LEVEL_RANGE of the largest, and
@@ -360,9 +390,10 @@ impl Levels<'_> {
         }
         // The frontier: the old one and the new cells, where they still touch pending cells.
         let mut frontier = std::mem::take(&mut self.frontier);
-        frontier.extend(accepted);
+        frontier.extend_from_slice(&accepted);
         frontier.retain(|&k| self.neighbours(k).any(|m| self.pending[m]));
         self.frontier = frontier;
+        accepted
     }
 
     /// This level's band: its core (breadth-first from the frontier) and its margin.
@@ -738,5 +769,54 @@ mod tests {
         // Everything between the agent and the target is kept, and 80 cells beyond it (46
         // decades; the bound's 50 are 87 cells of this corridor).
         assert!(path[..2_080].iter().all(|&k| cut.w.mantissa[k] > 0.0));
+    }
+
+    /// The nested levels of the serpentine from the target `(1, 1)`, with `stop`.
+    fn levels_with(grid: &Grid, reachable: &[bool], stop: &Stop) -> (ScaledW, LevelStats) {
+        let target = grid.index(1, 1);
+        let mut unknown = reachable.to_vec();
+        unknown[target] = false;
+        let mut w = vec![0.0; grid.len()];
+        w[target] = 1.0;
+        multigrid::solve(grid, &unknown, &mut w, 1e-12, MAX_ITERATIONS);
+        let pending = deep_cells(grid, &unknown, &w, DEPTH_STEP);
+        let mut w = ScaledW::from_plain(w);
+        let stats = solve_levels(grid, pending, &mut w, 1e-12, stop);
+        (w, stats)
+    }
+
+    /// Levels that stop once a box is solved (a coarse window, read only near its centre)
+    /// keep every cell of the box, each cell they keep is the full solve's to the bit, and they
+    /// solve far fewer cells; the others are left at 0.
+    #[test]
+    fn levels_that_stop_once_a_box_is_solved_keep_it_to_the_bit() {
+        let (grid, _, reachable, path) = serpentine(101);
+        let (full, all) = levels_with(&grid, &reachable, &Stop::Never);
+        // A box 2,000 cells down the corridor, across three of its rows.
+        let (i, j) = (path[2_000] % grid.nx, path[2_000] / grid.nx);
+        let inside = (i - 3..i + 4, j - 2..j + 3);
+        let (cut, part) = levels_with(
+            &grid,
+            &reachable,
+            &Stop::Within(inside.0.clone(), inside.1.clone()),
+        );
+        assert_eq!(all.left, 0);
+        assert!(part.left > 2_000, "{part:?}");
+        assert!(
+            2 * part.cells_solved < all.cells_solved,
+            "{part:?} against {all:?}"
+        );
+        let mut kept = 0;
+        for k in (0..grid.len()).filter(|&k| reachable[k]) {
+            let boxed = inside.0.contains(&(k % grid.nx)) && inside.1.contains(&(k / grid.nx));
+            if cut.mantissa[k] > 0.0 {
+                kept += 1;
+                assert_eq!(cut.mantissa[k], full.mantissa[k], "cell {k}");
+                assert_eq!(cut.exponent[k], full.exponent[k], "cell {k}");
+            } else {
+                assert!(!boxed, "cell {k} of the box left out");
+            }
+        }
+        assert_eq!(kept + part.left, reachable.iter().filter(|r| **r).count());
     }
 }

@@ -29,7 +29,7 @@ impl Stencil {
 
 /// How many cells beyond the interpolation stencil a point off the field looks for a reachable
 /// cell to take its guidance from.
-const NEAR: i64 = 3;
+pub(super) const NEAR: i64 = 3;
 
 /// `W` and its central-difference gradient at every cell centre, ready for interpolation.
 #[derive(Debug, Clone)]

@@ -24,7 +24,8 @@ use std::time::{Duration, Instant};
 use super::grid::Grid;
 use super::mask::{Disc, disc_cells, obstacle_discs};
 use super::multigrid;
-use super::nested::{DEPTH_STEP, MAX_ITERATIONS, deep_cells, solve_levels};
+use super::nested::{DEPTH_STEP, MAX_ITERATIONS, Stop, deep_cells, solve_levels};
+use super::sample::NEAR;
 use super::scaled::{ScaledW, exponent_of, ldexp};
 use super::{FieldError, Sampler};
 use crate::world::Agent;
@@ -204,7 +205,11 @@ impl Window {
             })),
             None if reach > half => {
                 let problem = coarse_problem((grid, reachable, w), agent, position, reach, &discs);
-                match solve_problem(problem, agent, position, tolerance) {
+                // Read only on the rings of the fine windows it serves (none but this one's
+                // when it covers the whole grid): its levels stop once those cells are solved.
+                let serves = if whole { 0.0 } else { 0.25 * reach };
+                let read = read_by_rings((&problem.grid, grid), position, half, serves);
+                match solve_problem(problem, agent, position, tolerance, &read) {
                     Ok((sampler, iterations)) => {
                         coarse_iterations = iterations;
                         Some(Arc::new(Coarse {
@@ -279,7 +284,8 @@ impl Window {
         if !whole && !leads_on(&problem, (grid, reachable, w), (&ir, &jr), position) {
             return Err(unreachable());
         }
-        let (sampler, iterations) = solve_problem(problem, agent, position, tolerance)?;
+        let (sampler, iterations) =
+            solve_problem(problem, agent, position, tolerance, &Stop::Never)?;
         let interior = [[1.0, local.nx as f64 - 2.0], [1.0, local.ny as f64 - 2.0]];
         Ok(Self {
             sampler,
@@ -312,6 +318,51 @@ impl Window {
     }
 }
 
+/// The coarse window's cells: [`COARSE`] times the cell of `grid`, half-side `reach` around
+/// `position`, clipped to `grid`.
+fn coarse_grid(grid: &Grid, position: [f64; 2], reach: f64) -> Grid {
+    let cell = grid.cell * COARSE as f64;
+    let (lo, hi) = grid.bounds();
+    let from = [
+        (position[0] - reach).max(lo[0]),
+        (position[1] - reach).max(lo[1]),
+    ];
+    let to = [
+        (position[0] + reach).min(hi[0]),
+        (position[1] + reach).min(hi[1]),
+    ];
+    Grid {
+        nx: (((to[0] - from[0]) / cell).ceil() as usize).max(1),
+        ny: (((to[1] - from[1]) / cell).ceil() as usize).max(1),
+        cell,
+        origin: from,
+    }
+}
+
+/// The cells of the coarse window on `coarse` (solved for an agent at `position` on `grid`)
+/// that the fine windows it serves read, as the box its nested levels may stop at
+/// ([`Stop::Within`]): it gives only the rings of windows of half-side `half` around agents
+/// within `serves` of `position`. A ring's cell centres lie within `half` and a fine cell of
+/// its agent, so within `serves + half + cell` of `position` (the box's extent, with a fine
+/// cell to spare); a sample reads the coarse cells of its interpolation stencil, or, off the
+/// field, the nearest reachable cell within [`NEAR`] more.
+fn read_by_rings(
+    (coarse, grid): (&Grid, &Grid),
+    position: [f64; 2],
+    half: f64,
+    serves: f64,
+) -> Stop {
+    let r = serves + half + 2.0 * grid.cell;
+    let (i, j) = coarse.cells_in(
+        [position[0] - r, position[1] - r],
+        [position[0] + r, position[1] + r],
+    );
+    let near = NEAR as usize;
+    let grow =
+        |r: std::ops::Range<usize>, n: usize| r.start.saturating_sub(near)..(r.end + near).min(n);
+    Stop::Within(grow(i, coarse.nx), grow(j, coarse.ny))
+}
+
 /// The coarse window: [`COARSE`] times the cell, half-side `reach` around `position`, clipped
 /// to the agent's grid. A coarse cell is free when the fine cell at its centre is reachable and
 /// no disc covers its centre; its ring holds the field of the walls, the cells of the target
@@ -323,22 +374,8 @@ fn coarse_problem(
     reach: f64,
     discs: &[Disc],
 ) -> Problem {
-    let cell = grid.cell * COARSE as f64;
-    let (lo, hi) = grid.bounds();
-    let from = [
-        (position[0] - reach).max(lo[0]),
-        (position[1] - reach).max(lo[1]),
-    ];
-    let to = [
-        (position[0] + reach).min(hi[0]),
-        (position[1] + reach).min(hi[1]),
-    ];
-    let coarse = Grid {
-        nx: (((to[0] - from[0]) / cell).ceil() as usize).max(1),
-        ny: (((to[1] - from[1]) / cell).ceil() as usize).max(1),
-        cell,
-        origin: from,
-    };
+    let coarse = coarse_grid(grid, position, reach);
+    let cell = coarse.cell;
     let n = coarse.len();
     let under_disc = stamp(&coarse, discs, agent.radius);
     let target_radius = agent.target_disc() + 0.5 * cell;
@@ -370,12 +407,14 @@ fn coarse_problem(
 /// free known cells with `W > 0`) are solved, at the scale of the largest Dirichlet value, then
 /// the nested levels below what the solve resolves, as in a full solve. The Dirichlet cells
 /// keep their own values and exponents (they may be deeper than f64 reaches at that scale).
-/// Returns the sampler and the iterations; an error when the agent at `position` is cut off.
+/// The nested levels may `stop` short of every cell (see [`Stop`]). Returns the sampler and
+/// the iterations; an error when the agent at `position` is cut off.
 fn solve_problem(
     problem: Problem,
     agent: &Agent,
     position: [f64; 2],
     tolerance: f64,
+    stop: &Stop,
 ) -> Result<(Sampler, usize), FieldError> {
     let Problem {
         grid: local,
@@ -446,7 +485,7 @@ fn solve_problem(
             scaled.exponent[k] = 0;
         }
     }
-    let nested = solve_levels(&local, pending, &mut scaled, tolerance, None);
+    let nested = solve_levels(&local, pending, &mut scaled, tolerance, stop);
     Ok((
         Sampler::new(local, scaled, connected),
         stats.iterations + nested.iterations,
@@ -578,5 +617,67 @@ mod tests {
             .unwrap();
         assert!(Arc::ptr_eq(&coarse(&next).sampler, &coarse(&again).sampler));
         assert_eq!(coarse(&again).reused, 1);
+    }
+
+    /// The box a coarse window's levels stop at holds every cell that a ring of a fine window
+    /// it serves can read: the interpolation stencils of the ring's cell centres and the
+    /// cells within `NEAR` of them, for agents anywhere within the reach it serves, near the
+    /// grid's edges too.
+    #[test]
+    fn a_coarse_window_keeps_every_cell_its_rings_read() {
+        let grid = Grid {
+            nx: 400,
+            ny: 300,
+            cell: 0.1,
+            origin: [-0.05, 0.03],
+        };
+        let (half, reach) = (3.0, 24.0);
+        for position in [[20.0, 15.0], [1.0, 2.0], [39.5, 29.0], [5.33, 27.1]] {
+            let coarse = coarse_grid(&grid, position, reach);
+            for serves in [0.0, 0.25 * reach] {
+                let Stop::Within(bi, bj) = read_by_rings((&coarse, &grid), position, half, serves)
+                else {
+                    panic!("a box");
+                };
+                let steps = 12;
+                for a in 0..=steps {
+                    for b in 0..=steps {
+                        let d = [a, b].map(|s| serves * (2.0 * s as f64 / steps as f64 - 1.0));
+                        if d[0].hypot(d[1]) >= serves && serves > 0.0 {
+                            continue;
+                        }
+                        let q = [position[0] + d[0], position[1] + d[1]];
+                        let (ir, jr) =
+                            grid.cells_in([q[0] - half, q[1] - half], [q[0] + half, q[1] + half]);
+                        for j in jr.clone() {
+                            for i in ir.clone() {
+                                let ring = i == ir.start
+                                    || j == jr.start
+                                    || i + 1 == ir.end
+                                    || j + 1 == jr.end;
+                                if !ring {
+                                    continue;
+                                }
+                                let p = grid.center(i, j);
+                                let f = [0, 1].map(|x| {
+                                    ((p[x] - coarse.origin[x]) / coarse.cell - 0.5).floor() as i64
+                                });
+                                let near = NEAR;
+                                for (f, range, n) in
+                                    [(f[0], &bi, coarse.nx), (f[1], &bj, coarse.ny)]
+                                {
+                                    let lo = (f - near).max(0) as usize;
+                                    let hi = ((f + 1 + near).min(n as i64 - 1)).max(0) as usize;
+                                    assert!(
+                                        range.contains(&lo) && range.contains(&hi),
+                                        "{position:?} serving {serves}: ring point {p:?} reads {lo}..={hi}, the box keeps {range:?}"
+                                    );
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 }
