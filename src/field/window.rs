@@ -40,7 +40,9 @@ use crate::world::Agent;
 ///   times the cell, solved the same way, with the field of the walls on its own ring. So
 ///   agents up to `replan_reach` away bend the guidance (a crowd ahead is gone around early).
 ///   It is re-solved every fifth replan, while the agent stays within a quarter of its reach of
-///   where it was solved (the agents it shows are far and move little between replans).
+///   where it was solved (the agents it shows are far and move little between replans); being
+///   read only on those windows' rings, its nested levels stop once the cells the rings read
+///   are solved (see `read_by_rings`).
 /// - Both are solved to a relative residual of 1e-9 (or the field's tolerance if looser): their
 ///   difference from a full re-solve, degrees of guidance near the others, is far above what a
 ///   tighter solve changes, and it takes about a third fewer iterations than 1e-12. Cells below
