@@ -132,13 +132,14 @@ impl HarmonicField {
         started: Instant,
     ) -> Result<Self, FieldError> {
         let grid = &space.grid;
+        let stop = (at.and_then(|p| grid.cell_of(p)))
+            .map_or(Stop::Never, |(i, j)| Stop::BelowAgent(grid.index(i, j)));
         let solution = solve_w_for(
             grid,
             (&space.reachable, &space.target_cells),
             world.field.tolerance,
             warm,
-            at.and_then(|p| grid.cell_of(p))
-                .map(|(i, j)| grid.index(i, j)),
+            &stop,
         );
         if solution.relative_residual.is_nan() || solution.relative_residual > world.field.tolerance
         {
@@ -448,21 +449,19 @@ pub fn solve_w(
     tolerance: f64,
     warm: Option<&[f64]>,
 ) -> HarmonicSolution {
-    solve_w_for(grid, (reachable, target), tolerance, warm, None)
+    solve_w_for(grid, (reachable, target), tolerance, warm, &Stop::Never)
 }
 
-/// [`solve_w`] for an agent at cell `agent`, if any: the nested levels stop once every cell
-/// left is below [`BELOW_AGENT`](super::BELOW_AGENT) of `W` there, and leave those cells at 0.
-/// Every cell kept is [`solve_w`]'s to the bit (the levels run alike until they stop, and only
-/// ever write cells not yet accepted), and none left out is above the bound (the cells not yet
-/// accepted are bounded by the largest `W` on the accepted cells around them: the maximum
-/// principle).
+/// [`solve_w`] with nested levels that may `stop` short of every cell and leave the rest at 0
+/// (for an agent, once every cell left is below [`BELOW_AGENT`](super::BELOW_AGENT) of `W`
+/// there: see [`Stop`]). Every cell kept is [`solve_w`]'s to the bit (the levels run alike
+/// until they stop, and only ever write cells not yet accepted).
 pub fn solve_w_for(
     grid: &Grid,
     (reachable, target): (&[bool], &[usize]),
     tolerance: f64,
     warm: Option<&[f64]>,
-    agent: Option<usize>,
+    stop: &Stop,
 ) -> HarmonicSolution {
     let mut unknown = reachable.to_vec();
     for &t in target {
@@ -482,8 +481,7 @@ pub fn solve_w_for(
     let first = multigrid::solve(grid, &unknown, &mut w, tolerance, MAX_ITERATIONS);
     let pending = deep_cells(grid, &unknown, &w, DEPTH_STEP);
     let mut w = ScaledW::from_plain(w);
-    let stop = agent.map_or(Stop::Never, Stop::BelowAgent);
-    let nested = solve_levels(grid, pending, &mut w, tolerance, &stop);
+    let nested = solve_levels(grid, pending, &mut w, tolerance, stop);
     HarmonicSolution {
         w,
         iterations: first.iterations + nested.iterations,

@@ -67,7 +67,7 @@ pub mod solvers {
     pub use super::harmonic::{solve_w, solve_w_for};
     pub use super::laplace::solve_sor;
     pub use super::multigrid::{set_portable, solve};
-    pub use super::nested::MAX_ITERATIONS;
+    pub use super::nested::{MAX_ITERATIONS, Stop};
     pub use super::pose::multigrid::{Dims, Lattice, solve as solve_pose};
 }
 

@@ -741,7 +741,7 @@ mod tests {
             (&reachable, &target),
             1e-12,
             None,
-            Some(agent),
+            &Stop::BelowAgent(agent),
         );
         assert_eq!(full.nested.left, 0);
         assert!(cut.nested.left > 2_000, "{:?}", cut.nested);
@@ -771,18 +771,12 @@ mod tests {
         assert!(path[..2_080].iter().all(|&k| cut.w.mantissa[k] > 0.0));
     }
 
-    /// The nested levels of the serpentine from the target `(1, 1)`, with `stop`.
+    /// The field of the serpentine from the target `(1, 1)`, its nested levels stopping as
+    /// `stop` allows.
     fn levels_with(grid: &Grid, reachable: &[bool], stop: &Stop) -> (ScaledW, LevelStats) {
-        let target = grid.index(1, 1);
-        let mut unknown = reachable.to_vec();
-        unknown[target] = false;
-        let mut w = vec![0.0; grid.len()];
-        w[target] = 1.0;
-        multigrid::solve(grid, &unknown, &mut w, 1e-12, MAX_ITERATIONS);
-        let pending = deep_cells(grid, &unknown, &w, DEPTH_STEP);
-        let mut w = ScaledW::from_plain(w);
-        let stats = solve_levels(grid, pending, &mut w, 1e-12, stop);
-        (w, stats)
+        let target = [grid.index(1, 1)];
+        let s = crate::field::harmonic::solve_w_for(grid, (reachable, &target), 1e-12, None, stop);
+        (s.w, s.nested)
     }
 
     /// Levels that stop once a box is solved (a coarse window, read only near its centre)

@@ -664,12 +664,11 @@ mod tests {
                                 let f = [0, 1].map(|x| {
                                     ((p[x] - coarse.origin[x]) / coarse.cell - 0.5).floor() as i64
                                 });
-                                let near = NEAR;
                                 for (f, range, n) in
                                     [(f[0], &bi, coarse.nx), (f[1], &bj, coarse.ny)]
                                 {
-                                    let lo = (f - near).max(0) as usize;
-                                    let hi = ((f + 1 + near).min(n as i64 - 1)).max(0) as usize;
+                                    let lo = (f - NEAR).max(0) as usize;
+                                    let hi = ((f + 1 + NEAR).min(n as i64 - 1)).max(0) as usize;
                                     assert!(
                                         range.contains(&lo) && range.contains(&hi),
                                         "{position:?} serving {serves}: ring point {p:?} reads {lo}..={hi}, the box keeps {range:?}"
