@@ -74,9 +74,10 @@ fn every_wheeled_world_reaches_untouched_within_the_wheels_limits() {
 /// heading oscillate: δ_m of the point under 7 cm and no reversal of the turn in the TurtleBot3
 /// world, the paper's room and the dead end (measured 4.1, 6.2 and 3.6 cm). In the dead end,
 /// started facing the side wall, both laws must turn in place (measured 1.7 and 2.7 rad/s).
-/// Started facing straight into it, NADF backs out without turning, while the peers' law turns
-/// back and forth as it reverses, where the guidance points straight behind it (55 reversals
-/// measured).
+/// Started facing straight into it, where the guidance points straight behind it, NADF turns
+/// round once and never back (measured: 0 reversals, settling at 14.23 s as when it backed out
+/// straight in f32 physics, where the field's 1e-12 asymmetry was rounded away), while the
+/// peers' law turns back and forth as it reverses (55 reversals measured).
 #[test]
 fn nadf_keeps_the_point_on_the_path_and_the_heading_steady() {
     for name in [
@@ -95,10 +96,7 @@ fn nadf_keeps_the_point_on_the_path_and_the_heading_steady() {
     let straight = ["agents.0.heading=0.0"];
     let (_, nadf) = drive_run("burger-dead-end.toml", false, &straight);
     let (_, peers) = drive_run("burger-dead-end.toml", true, &straight);
-    assert!(
-        nadf.heading_reversals == 0 && nadf.peak_turn_rate < 0.1,
-        "{nadf:?}"
-    );
+    assert_eq!(nadf.heading_reversals, 0, "{nadf:?}");
     assert!(peers.heading_reversals > 10, "{peers:?}");
 }
 

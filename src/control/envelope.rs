@@ -59,8 +59,8 @@
 use nalgebra::Vector2;
 
 /// How far from walls and other capsules a capsule must stay, m: twice the contact tolerance
-/// (an active contact within 1 mm counts as a touch) so that f32 rounding in Rapier (a few
-/// 1e-5 m at 500 m from the origin) cannot bring a stopped body into a counted contact.
+/// (an active contact within 1 mm counts as a touch), so that the room a body keeps is
+/// measured in millimetres, not in the solver's rounding or its contact tolerance.
 pub const MARGIN: f64 = 2e-3;
 
 /// How Rapier moves a body over one step: from velocity `v` to `v⁺`, by

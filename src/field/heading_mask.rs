@@ -224,7 +224,7 @@ fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
 fn core_of(wall: &WallShape) -> (Vec<[f64; 2]>, f64) {
     let world = |p: parry2d::math::Vector| {
         let q = wall.pose * p;
-        [f64::from(q.x), f64::from(q.y)]
+        [q.x, q.y]
     };
     let shape = wall.shape.as_ref();
     if let Some(c) = shape.as_cuboid() {
@@ -235,13 +235,10 @@ fn core_of(wall: &WallShape) -> (Vec<[f64; 2]>, f64) {
     }
     if let Some(c) = shape.as_capsule() {
         let ends = [c.segment.a, c.segment.b].map(world);
-        return (ends.to_vec(), f64::from(c.radius));
+        return (ends.to_vec(), c.radius);
     }
     if let Some(b) = shape.as_ball() {
-        return (
-            vec![world(parry2d::math::Vector::ZERO)],
-            f64::from(b.radius),
-        );
+        return (vec![world(parry2d::math::Vector::ZERO)], b.radius);
     }
     if let Some(p) = shape.as_convex_polygon() {
         return (p.points().iter().map(|&v| world(v)).collect(), 0.0);
@@ -251,10 +248,7 @@ fn core_of(wall: &WallShape) -> (Vec<[f64; 2]>, f64) {
     let aabb = shape.compute_aabb(&wall.pose);
     let (a, b) = (aabb.mins, aabb.maxs);
     let corners = [[a.x, a.y], [b.x, a.y], [b.x, b.y], [a.x, b.y]];
-    (
-        corners.map(|[x, y]| [f64::from(x), f64::from(y)]).to_vec(),
-        0.0,
-    )
+    (corners.map(|[x, y]| [x, y]).to_vec(), 0.0)
 }
 
 /// The convex hull of `{w − p}` for the vertices `w` of `core` and `p` of `part`: the
@@ -372,19 +366,17 @@ mod tests {
     /// 0 where it touches or overlaps a wall), m.
     fn clearance(walls: &[WallShape], parts: &[Vec<[f64; 2]>], pose: [f64; 3], size: f64) -> f64 {
         let [x, y, theta] = pose;
-        let at = Pose::new(Vector::new(x as f32, y as f32), theta as f32);
+        let at = Pose::new(Vector::new(x, y), theta);
         let mut gap = f64::INFINITY;
         for part in parts {
             let polygon = ConvexPolygon::from_convex_polyline(
-                part.iter()
-                    .map(|&[a, b]| Vector::new(a as f32, b as f32))
-                    .collect(),
+                part.iter().map(|&[a, b]| Vector::new(a, b)).collect(),
             )
             .unwrap();
             for wall in walls {
                 let d = parry2d::query::distance(&at, &polygon, &wall.pose, wall.shape.as_ref())
                     .unwrap();
-                gap = gap.min(f64::from(d.distance));
+                gap = gap.min(d.distance);
             }
             let (s, c) = theta.sin_cos();
             for &[a, b] in part {

@@ -201,10 +201,7 @@ impl Scene<'_> {
         }
         let mid = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
         let half = 0.5 * (b[0] - a[0]).hypot(b[1] - a[1]);
-        let segment = Segment::new(
-            Vector::new(a[0] as f32, a[1] as f32),
-            Vector::new(b[0] as f32, b[1] as f32),
-        );
+        let segment = Segment::new(Vector::new(a[0], a[1]), Vector::new(b[0], b[1]));
         self.walls.iter().any(|wall| {
             wall.distance_bound(mid[0], mid[1]) - half <= keep
                 && parry2d::query::distance(
@@ -213,7 +210,7 @@ impl Scene<'_> {
                     &wall.pose,
                     wall.shape.as_ref(),
                 )
-                .is_ok_and(|d| f64::from(d.distance) <= keep)
+                .is_ok_and(|d| d.distance <= keep)
         })
     }
 }
@@ -296,14 +293,11 @@ mod tests {
         let mut gap = f64::INFINITY;
         for (i, s) in segments.iter().enumerate() {
             let r = chain.links[i].radius + spare * eps[i];
-            let seg = Segment::new(
-                Vector::new(s[0][0] as f32, s[0][1] as f32),
-                Vector::new(s[1][0] as f32, s[1][1] as f32),
-            );
+            let seg = Segment::new(Vector::new(s[0][0], s[0][1]), Vector::new(s[1][0], s[1][1]));
             for w in walls {
                 let d = parry2d::query::distance(&Pose::IDENTITY, &seg, &w.pose, w.shape.as_ref())
                     .unwrap();
-                gap = gap.min(f64::from(d.distance) - r);
+                gap = gap.min(d.distance - r);
             }
             for p in s {
                 gap = gap.min(p[0].min(p[1]).min(size - p[0]).min(size - p[1]) - r);

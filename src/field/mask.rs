@@ -35,10 +35,10 @@ impl Disc {
     pub fn shape(&self) -> WallShape {
         WallShape::new(
             parry2d::math::Pose::from_translation(parry2d::math::Vector::new(
-                self.center[0] as f32,
-                self.center[1] as f32,
+                self.center[0],
+                self.center[1],
             )),
-            parry2d::shape::SharedShape::ball(self.radius as f32),
+            parry2d::shape::SharedShape::ball(self.radius),
         )
     }
 }
@@ -294,10 +294,20 @@ impl CellCounts {
     }
 }
 
+/// How near a cell may be to the edge of a wall's configuration obstacle and still count as off
+/// it (free), m. Worlds with round numbers put cells exactly on that edge (a 0.5 m disc at
+/// (4, 2) and a 0.3 m robot: the cells at (4, 1.2) and (4, 2.8)), where the distance f64 gives
+/// is a rounding either side of `radius`: 0.8 for one and 0.7999999999999998 for the other,
+/// and a symmetric world got an asymmetric mask. The rule is that a cell is blocked when its
+/// distance is *below* the radius, so a cell that near the edge is free on both sides. Far
+/// below any cell, far above f64's rounding of coordinates.
+pub const ON_THE_EDGE: f64 = 1e-9;
+
 /// `blocked[grid.index(i, j)]` for every cell, for a disc of `radius` metres in the box
 /// `[lo, hi]`, with wall `k`'s boundary moved out by `offsets[k]` metres (in where negative;
 /// missing offsets are zero: the exact walls): the mask of walls sensed with errors. A cell is
-/// blocked when its signed distance to a wall is below `radius + offset`.
+/// blocked when its signed distance to a wall is below `radius + offset` by more than
+/// [`ON_THE_EDGE`].
 pub fn rasterize(
     grid: &Grid,
     (lo, hi): ([f64; 2], [f64; 2]),
@@ -317,18 +327,12 @@ pub fn rasterize(
     }
     for (n, wall) in walls.iter().enumerate() {
         let offset = offsets.get(n).copied().unwrap_or(0.0);
-        let reach = radius + offset;
+        let reach = radius + offset - ON_THE_EDGE;
         // Only the cells near the wall's bounding box can be within `reach` of it.
         let radius = reach.max(0.0);
         let aabb = wall.shape.compute_aabb(&wall.pose);
-        let lo = [
-            f64::from(aabb.mins.x) - radius,
-            f64::from(aabb.mins.y) - radius,
-        ];
-        let hi = [
-            f64::from(aabb.maxs.x) + radius,
-            f64::from(aabb.maxs.y) + radius,
-        ];
+        let lo = [aabb.mins.x - radius, aabb.mins.y - radius];
+        let hi = [aabb.maxs.x + radius, aabb.maxs.y + radius];
         let (ir, jr) = grid.cells_in(lo, hi);
         for j in jr {
             for i in ir.clone() {
@@ -337,7 +341,7 @@ pub fn rasterize(
                     let [x, y] = grid.center(i, j);
                     // The sensed case needs the signed distance (a thinner wall shrinks
                     // inside); the exact case keeps parry's solid distance query, which
-                    // differs from the projection in the last f32 bits at the mask's edge.
+                    // differs from the projection in the last bits at the mask's edge.
                     blocked[k] = if offset == 0.0 {
                         wall.distance_to_point(x, y) < reach
                     } else {
@@ -354,6 +358,33 @@ pub fn rasterize(
 mod tests {
     use super::*;
     use crate::world::{Wall, wall_shape};
+
+    /// A symmetric world gets a symmetric mask: the cells exactly on the edge of the disc's
+    /// configuration obstacle, above and below it, are both free (f64 puts one at 0.8 m and
+    /// the other at 0.7999999999999998 m from the disc's centre).
+    #[test]
+    fn cells_on_the_edge_of_an_obstacle_are_free_on_both_sides() {
+        let size = [8.0, 4.0];
+        // Cells centred on the target (7, 2), as the field's grids are.
+        let grid = Grid::anchored(size, 0.05, [7.0, 2.0]);
+        let disc = wall_shape(&Wall::Disc {
+            center: [4.0, 2.0],
+            radius: 0.5,
+        })
+        .unwrap();
+        let blocked = rasterize(&grid, ([0.0, 0.0], size), &[disc], 0.3, &[]);
+        let at = |i: usize, j: usize| blocked[grid.index(i, j)];
+        let cell = |p: [f64; 2]| grid.cell_of(p).unwrap();
+        let ((i, below), (_, middle), (_, above)) =
+            (cell([4.0, 1.2]), cell([4.0, 2.0]), cell([4.0, 2.8]));
+        assert!((grid.center(i, below)[1] - 1.2).abs() < 1e-12);
+        assert!(!at(i, below) && !at(i, above) && at(i, below + 1) && at(i, above - 1));
+        for d in 0..=middle.min(grid.ny - 1 - middle) {
+            for i in 0..grid.nx {
+                assert_eq!(at(i, middle - d), at(i, middle + d), "{i} {d}");
+            }
+        }
+    }
 
     #[test]
     fn sensed_offsets_grow_and_shrink_a_wall() {

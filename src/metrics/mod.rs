@@ -163,7 +163,8 @@ crate::measured! {
         /// flat, or the body was off the field. Not counted within two cells of the target or
         /// within the rim of its disc (`HarmonicField::rim`).
         pub guidance_lost_steps: usize,
-        /// Steps whose control force could not be given to Rapier (not finite in f32); zero
+        /// Steps whose control force could not be given to Rapier or recorded (not finite in
+        /// f32, the recording's precision); zero
         /// was applied instead.
         pub rejected_forces: usize,
         /// Times the body was pushed more than 1 cm into a wall.

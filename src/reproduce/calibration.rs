@@ -34,7 +34,7 @@ pub const T_FIGURE_16: f64 = 12.0;
 
 /// K of the paper's law `F = −K∇V`, J (N·m: V is dimensionless), calibrated so that NADF
 /// B_d = 10 settles in [`T_FIGURE_16`].
-pub const K_PAPER: f64 = 1080.0;
+pub const K_PAPER: f64 = 1036.0;
 
 /// K of normalized guidance `F = −K∇V/|∇V|`, N, calibrated the same way.
 pub const K_NORMALIZED: f64 = 0.148;

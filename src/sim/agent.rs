@@ -896,7 +896,7 @@ impl AgentRun {
             radius: sweep.radius,
         };
         envelope.filter(force, state, self.external, step, |sweep| {
-            // Keeping the margin, or (already nearer, rounded in Rapier's f32) no nearer than
+            // Keeping the margin, or (already nearer: Rapier resolves the step a little differently) no nearer than
             // it is: a body stopped at the margin may still move along or away.
             let apart = sweeps.iter().enumerate().all(|(j, other)| {
                 if j == index || !sweep.near(other, ENVELOPE_MARGIN) {
@@ -1240,11 +1240,7 @@ impl AgentRun {
                 (pair.collider1, -1.0)
             };
             for manifold in pair.manifolds() {
-                if manifold
-                    .points
-                    .iter()
-                    .any(|c| f64::from(c.dist) <= CONTACT_TOLERANCE)
-                {
+                if manifold.points.iter().any(|c| c.dist <= CONTACT_TOLERANCE) {
                     // The normal points from collider 1 to collider 2.
                     let n = from_rapier(manifold.data.normal);
                     points.push(position + n * (side * radius));

@@ -48,8 +48,7 @@ impl ArmBodies {
     /// them do.
     pub fn insert(physics: &mut PhysicsWorld, chain: &Chain, q: &[f64]) -> Self {
         let [bx, by] = chain.base;
-        let base = physics
-            .insert_body(RigidBodyBuilder::fixed().translation(Vector::new(bx as f32, by as f32)));
+        let base = physics.insert_body(RigidBodyBuilder::fixed().translation(Vector::new(bx, by)));
         // Built straight along x (every joint at 0), then turned to q by the multibody.
         let mut links = Vec::new();
         let mut joints = Vec::new();
@@ -58,19 +57,19 @@ impl ArmBodies {
         let mut x = bx;
         for link in &chain.links {
             let body = RigidBodyBuilder::dynamic()
-                .translation(Vector::new((x + link.com) as f32, by as f32))
+                .translation(Vector::new(x + link.com, by))
                 .can_sleep(false)
                 .additional_mass_properties(MassProperties::new(
                     Vector::ZERO,
-                    link.mass as f32,
-                    link.inertia() as f32,
+                    link.mass,
+                    link.inertia(),
                 ));
             let handle = physics.insert_body(body);
-            let (a, b) = (-link.com as f32, (link.length - link.com) as f32);
+            let (a, b) = (-link.com, (link.length - link.com));
             let collider = ColliderBuilder::capsule_from_endpoints(
                 Vector::new(a, 0.0),
                 Vector::new(b, 0.0),
-                link.radius as f32,
+                link.radius,
             )
             .density(0.0)
             .friction(0.0)
@@ -102,8 +101,7 @@ impl ArmBodies {
         {
             // The first pass sets the multibody's degrees of freedom up.
             multibody.forward_kinematics(&physics.bodies, true);
-            let turn: Vec<f32> = q.iter().map(|&a| a as f32).collect();
-            multibody.apply_displacements(&turn);
+            multibody.apply_displacements(q);
             multibody.forward_kinematics(&physics.bodies, true);
             multibody.update_rigid_bodies(&mut physics.bodies, true);
         }
@@ -117,7 +115,7 @@ impl ArmBodies {
             .filter_map(|&j| {
                 let (multibody, link) = physics.multibody_joints.get(j)?;
                 let coords = multibody.link(link)?.joint().coords();
-                Some(f64::from(coords.z))
+                Some(coords.z)
             })
             .collect()
     }
@@ -131,9 +129,7 @@ impl ArmBodies {
         };
         let v = multibody.generalized_velocity();
         let offset = v.len() - self.joints.len();
-        (0..self.joints.len())
-            .map(|i| f64::from(v[offset + i]))
-            .collect()
+        (0..self.joints.len()).map(|i| v[offset + i]).collect()
     }
 
     /// Resets the links' forces and applies the joint torques `tau` (N·m): joint `i`'s on link
@@ -145,9 +141,9 @@ impl ArmBodies {
             body.reset_torques(false);
         }
         for (i, &t) in tau.iter().enumerate() {
-            physics.bodies[self.links[i]].add_torque(t as f32, true);
+            physics.bodies[self.links[i]].add_torque(t, true);
             if i > 0 {
-                physics.bodies[self.links[i - 1]].add_torque(-t as f32, true);
+                physics.bodies[self.links[i - 1]].add_torque(-t, true);
             }
         }
     }
@@ -171,8 +167,8 @@ impl ArmBodies {
         for link in multibody.links() {
             let body = &physics.bodies[link.rigid_body_handle()];
             let (m, inertia) = (
-                f64::from(body.mass()),
-                f64::from(body.mass_properties().local_mprops.principal_inertia()),
+                body.mass(),
+                body.mass_properties().local_mprops.principal_inertia(),
             );
             if m == 0.0 {
                 continue;
@@ -183,8 +179,8 @@ impl ArmBodies {
             for a in 0..dofs {
                 for b in 0..dofs {
                     let (ja, jb) = (
-                        |r: usize| f64::from(jac[(r, offset + a)]),
-                        |r: usize| f64::from(jac[(r, offset + b)]),
+                        |r: usize| jac[(r, offset + a)],
+                        |r: usize| jac[(r, offset + b)],
                     );
                     d[(a, b)] += m * (ja(0) * jb(0) + ja(1) * jb(1)) + inertia * ja(2) * jb(2);
                 }
@@ -268,7 +264,7 @@ mod tests {
     use crate::world::{Wall, wall_shape};
 
     /// Rapier's multibody, posed at the same joint angles, has the Lagrangian's joints, and its
-    /// inertia matrix is the Lagrangian's to f32 precision, at configurations spread over the
+    /// inertia matrix is the Lagrangian's to 1e-5 (the test's tolerance), at configurations spread over the
     /// joint space.
     #[test]
     fn rapier_and_the_lagrangian_agree_on_the_inertia_matrix() {
@@ -292,7 +288,7 @@ mod tests {
             for (h, p) in arm.links.iter().zip(c.centres(q)) {
                 let t = physics.bodies[*h].translation();
                 assert!(
-                    (f64::from(t.x) - p[0]).abs() < 1e-5 && (f64::from(t.y) - p[1]).abs() < 1e-5,
+                    (t.x - p[0]).abs() < 1e-5 && (t.y - p[1]).abs() < 1e-5,
                     "case {n}: {t:?} vs {p:?}"
                 );
             }
@@ -313,7 +309,7 @@ mod tests {
     /// 2.3 rad past a post, without gravity, under the paper's `τ = −K∇V − B_d L M`, simulated by
     /// Rapier's multibody (Coriolis and centripetal terms included), never lets
     /// `K·V + ½ q̇ᵀ D q̇` grow outside the target set and its bowl by more than integration
-    /// error (Rapier's f32 step), ends at the target joints (the bowl leads it there; measured
+    /// error (Rapier's step), ends at the target joints (the bowl leads it there; measured
     /// 1.3e-5 rad after 30 s, having crawled the field's shallow part for 19 s and swung once
     /// through the target), and touches nothing.
     #[test]

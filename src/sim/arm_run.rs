@@ -242,7 +242,7 @@ impl ArmRun {
         };
         let tau: Vec<f64> = tau
             .into_iter()
-            .map(|t| if (t as f32).is_finite() { t } else { 0.0 })
+            .map(|t| if t.is_finite() { t } else { 0.0 })
             .collect();
         if bias_updated {
             let error = match &self.settings.target_joints {
@@ -282,11 +282,8 @@ impl ArmRun {
                 } else {
                     pair.collider1
                 };
-                let touches = (pair.manifolds().iter()).any(|m| {
-                    m.points
-                        .iter()
-                        .any(|c| f64::from(c.dist) <= CONTACT_TOLERANCE)
-                });
+                let touches = (pair.manifolds().iter())
+                    .any(|m| m.points.iter().any(|c| c.dist <= CONTACT_TOLERANCE));
                 if touches {
                     now.insert((collider, other));
                 }
@@ -306,8 +303,8 @@ impl ArmRun {
         }
         for (link, s) in self.chain.links.iter().zip(joints.windows(2)) {
             let segment = parry2d::shape::Segment::new(
-                Vector::new(s[0][0] as f32, s[0][1] as f32),
-                Vector::new(s[1][0] as f32, s[1][1] as f32),
+                Vector::new(s[0][0], s[0][1]),
+                Vector::new(s[1][0], s[1][1]),
             );
             let mid = [(s[0][0] + s[1][0]) / 2.0, (s[0][1] + s[1][1]) / 2.0];
             let half = 0.5 * segment_distance([s[0], s[1]], [s[0], s[0]]);
@@ -318,8 +315,7 @@ impl ArmRun {
                 if let Ok(d) =
                     parry2d::query::distance(&Pose::IDENTITY, &segment, &w.pose, w.shape.as_ref())
                 {
-                    self.min_clearance =
-                        self.min_clearance.min(f64::from(d.distance) - link.radius);
+                    self.min_clearance = self.min_clearance.min(d.distance - link.radius);
                 }
             }
         }

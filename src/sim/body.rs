@@ -5,8 +5,8 @@
 //! ([`ConfigurationSpace`], in `field`) and its body in Rapier (here), both in the coordinates
 //! whose metric makes its inertia `m·I` (see `field/space.rs`). The body reads its configuration
 //! and velocity from Rapier in those coordinates and turns a force in them into Rapier's forces
-//! and torques (the one conversion between the laws' nalgebra `f64` and Rapier's `glam` `f32`
-//! is in `physics.rs`). [`control`] joins a space and a controller: the guidance at the body's
+//! and torques (the one conversion between the laws' nalgebra vectors and Rapier's `glam` ones
+//! is in `physics.rs`; both are f64). [`control`] joins a space and a controller: the guidance at the body's
 //! configuration, the control force, checked for Rapier.
 //!
 //! - [`DiscBody`]: a disc that does not turn, in the plane (`agent.rs`).
@@ -85,7 +85,7 @@ impl Body<3> for TurningBody {
     fn state(&self, physics: &PhysicsWorld) -> Option<(Pose, Vector3<f64>)> {
         let body = &physics.bodies[self.handle];
         let (p, v) = (from_rapier(body.translation()), from_rapier(body.linvel()));
-        let (angle, omega) = (f64::from(body.rotation().angle()), f64::from(body.angvel()));
+        let (angle, omega) = (body.rotation().angle(), body.angvel());
         let heading = self.heading + angle_difference(angle, self.heading);
         let all = [p.x, p.y, v.x, v.y, angle, omega];
         all.iter().all(|c| c.is_finite()).then(|| {
@@ -101,7 +101,7 @@ impl Body<3> for TurningBody {
         body.reset_forces(false);
         body.reset_torques(false);
         body.add_force(to_rapier(Vector2::new(force.x, force.y)), true);
-        body.add_torque(self.torque(force) as f32, true);
+        body.add_torque(self.torque(force), true);
     }
 }
 
@@ -124,8 +124,8 @@ pub struct Sensed<const N: usize> {
 /// [`Controller::step`](crate::control::Controller::step), or its side-effect-free
 /// [`Controller::evaluate`](crate::control::Controller::evaluate)). `reference` gives
 /// the velocity a tracking law follows (ORCA's) from the offset and the gradient, if any. The
-/// force is zero, and the second value `true`, when it is finite in f64 but not in Rapier's
-/// f32.
+/// force is zero, and the second value `true`, when it is not finite in f32 (the recording's
+/// precision; Rapier's is f64).
 pub fn control<const N: usize, S: ConfigurationSpace<N>>(
     space: &S,
     law: impl FnOnce(&ControlInput<N>) -> ControlOutput<N>,
@@ -146,7 +146,8 @@ pub fn control<const N: usize, S: ConfigurationSpace<N>>(
         reference_velocity,
     };
     let mut out = law(&input);
-    // Finite in f64 but beyond f32's range is still not finite for Rapier.
+    // Rapier is f64, but the recording (Rerun's arrows) is f32: a force beyond f32's range
+    // (3.4e38 N, far beyond any law that has not run away) would be infinite there.
     let rejected = !out.force.iter().all(|c| (*c as f32).is_finite());
     if rejected {
         out.force = SVector::zeros();

@@ -145,8 +145,8 @@ impl DriveBody {
         Kinematics {
             centre: from_rapier(body.translation()),
             velocity: from_rapier(body.linvel()),
-            theta: f64::from(body.rotation().angle()),
-            omega: f64::from(body.angvel()),
+            theta: body.rotation().angle(),
+            omega: body.angvel(),
         }
     }
 
@@ -348,7 +348,7 @@ impl DriveBody {
         body.reset_torques(false);
         if total.iter().all(|c| c.is_finite()) && t.is_finite() {
             body.add_force(to_rapier(total), true);
-            body.add_torque(t as f32, true);
+            body.add_torque(t, true);
         }
     }
 }
@@ -466,8 +466,8 @@ mod tests {
     fn robot(omega: f64, v: [f64; 2]) -> (PhysicsWorld, DriveBody) {
         let mut physics = empty_world(0.01, [0.0, 0.0]);
         let body = RigidBodyBuilder::dynamic()
-            .linvel(Vector::new(v[0] as f32, v[1] as f32))
-            .angvel(omega as f32)
+            .linvel(Vector::new(v[0], v[1]))
+            .angvel(omega)
             .additional_mass_properties(MassProperties::new(Vector::ZERO, 1.0, 0.005));
         let collider = ColliderBuilder::ball(0.1).density(0.0);
         let (handle, _) = physics.insert(body, collider);

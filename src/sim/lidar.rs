@@ -67,16 +67,16 @@ impl Lidar {
         let fov = self.settings.fov.unwrap_or(360.0).to_radians();
         let dropout = self.settings.dropout.unwrap_or(0.0);
         let filter = QueryFilter::default().exclude_collider(own);
-        let origin = Vector::new(from[0] as f32, from[1] as f32);
+        let origin = Vector::new(from[0], from[1]);
         let mut beams = Vec::with_capacity(rays as usize);
         self.ranges.clear();
         for k in 0..rays {
             let angle = heading - 0.5 * fov + (k as f64 + 0.5) * fov / rays as f64;
             let (sin, cos) = angle.sin_cos();
-            let ray = Ray::new(origin, Vector::new(cos as f32, sin as f32));
+            let ray = Ray::new(origin, Vector::new(cos, sin));
             let hit = physics
-                .cast_ray(&ray, range as f32, true, filter)
-                .map(|(_, toi)| f64::from(toi));
+                .cast_ray(&ray, range, true, filter)
+                .map(|(_, toi)| toi);
             // Draw both every time, so that one ray's outcome does not shift the others' noise.
             let (lost, noise) = (self.rng.uniform() < dropout, self.rng.normal());
             if lost {

@@ -40,7 +40,7 @@ impl ObstacleRun {
         let seed = world.seed ^ (index as u64 + 1).wrapping_mul(0xA076_1D64_78BD_642F);
         let start = Vector2::from(obstacle.start());
         let motion = Motion::starting_at(script(&obstacle), start, seed);
-        let pose = Pose::new(to_rapier(start), obstacle.angle as f32);
+        let pose = Pose::new(to_rapier(start), obstacle.angle);
         let body = physics.insert_body(RigidBodyBuilder::kinematic_position_based().pose(pose));
         let collider = ColliderBuilder::new(local.shape.clone())
             .friction(0.0)
@@ -66,7 +66,7 @@ impl ObstacleRun {
         self.velocity = (to - from) / dt;
         self.angle = self.obstacle.angle + self.obstacle.angular_speed * self.motion.time();
         if let Some(body) = physics.bodies.get_mut(self.body) {
-            body.set_next_kinematic_position(Pose::new(to_rapier(to), self.angle as f32));
+            body.set_next_kinematic_position(Pose::new(to_rapier(to), self.angle));
         }
     }
 
@@ -93,7 +93,7 @@ impl ObstacleRun {
     /// Its shape where it is now.
     pub fn shape(&self) -> WallShape {
         let p = self.position();
-        let pose = Pose::new(Vector::new(p.x as f32, p.y as f32), self.angle as f32);
+        let pose = Pose::new(Vector::new(p.x, p.y), self.angle);
         WallShape::new(pose * self.local.pose, self.local.shape.clone())
     }
 
@@ -272,7 +272,7 @@ mod tests {
         assert!(!end.reciprocal);
         // Rapier's body is where the script put it.
         let body = &physics.bodies[run.body];
-        assert!((f64::from(body.rotation().angle()) - run.angle()).abs() < 1e-5);
+        assert!((body.rotation().angle() - run.angle()).abs() < 1e-5);
         let shape = run.shape();
         assert!(shape.distance_to_point(5.0, 5.75) < 1e-4);
         assert!(shape.distance_to_point(5.75, 5.0) > 0.6);

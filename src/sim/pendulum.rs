@@ -120,18 +120,17 @@ pub fn static_error(p: &Pendulum, acceleration: [f64; 2]) -> Option<f64> {
 pub fn insert(physics: &mut PhysicsWorld, pendulum: &Pendulum) -> PendulumRun {
     let [px, py] = pendulum.pivot;
     let (l, theta) = (pendulum.length, pendulum.start);
-    let pivot = physics
-        .insert_body(RigidBodyBuilder::fixed().translation(Vector::new(px as f32, py as f32)));
+    let pivot = physics.insert_body(RigidBodyBuilder::fixed().translation(Vector::new(px, py)));
     let bob_at = [px + l * theta.sin(), py - l * theta.cos()];
     let bob = physics.insert_body(
         RigidBodyBuilder::dynamic()
-            .translation(Vector::new(bob_at[0] as f32, bob_at[1] as f32))
-            .rotation(theta as f32)
+            .translation(Vector::new(bob_at[0], bob_at[1]))
+            .rotation(theta)
             .can_sleep(false),
     );
     physics.insert_collider(
-        ColliderBuilder::ball(BOB_RADIUS as f32)
-            .mass(pendulum.mass as f32)
+        ColliderBuilder::ball(BOB_RADIUS)
+            .mass(pendulum.mass)
             .sensor(true),
         Some(bob),
     );
@@ -140,7 +139,7 @@ pub fn insert(physics: &mut PhysicsWorld, pendulum: &Pendulum) -> PendulumRun {
         bob,
         RevoluteJointBuilder::new()
             .local_anchor1(Vector::ZERO)
-            .local_anchor2(Vector::new(0.0, l as f32)),
+            .local_anchor2(Vector::new(0.0, l)),
     );
     let c = &pendulum.controller;
     // The torque turns the bob about the pivot: M L² plus the bob's own ½ M r².
@@ -204,14 +203,14 @@ impl PendulumRun {
         }
         let body = &mut physics.bodies[self.body];
         body.reset_torques(false);
-        body.add_torque(torque as f32, true);
+        body.add_torque(torque, true);
     }
 
     /// Reads the pendulum's state back from Rapier after a step that ended at `time` (s).
     pub fn observe(&mut self, physics: &PhysicsWorld, time: f64) {
         let body = &physics.bodies[self.body];
         // Unwrap Rapier's angle in (−π, π] onto the continuous θ.
-        let wrapped = f64::from(body.rotation().angle());
+        let wrapped = body.rotation().angle();
         let turn = std::f64::consts::TAU;
         let delta = (wrapped - self.state.theta).rem_euclid(turn);
         let delta = if delta > 0.5 * turn {
@@ -219,13 +218,13 @@ impl PendulumRun {
         } else {
             delta
         };
-        let (theta, omega) = (self.state.theta + delta, f64::from(body.angvel()));
+        let (theta, omega) = (self.state.theta + delta, body.angvel());
         if theta.is_finite() && omega.is_finite() {
             self.state.theta = theta;
             self.state.omega = omega;
         }
         let t = body.translation();
-        self.state.bob = [f64::from(t.x), f64::from(t.y)];
+        self.state.bob = [t.x, t.y];
         let error = (self.pendulum.target - self.state.theta).abs();
         if error > self.band {
             self.settled_at = None;

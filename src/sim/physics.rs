@@ -1,5 +1,11 @@
 //! Building the Rapier world from a world file, and the one conversion between the control
-//! laws' nalgebra `f64` vectors and Rapier's `glam` `f32` ones.
+//! laws' nalgebra vectors and Rapier's `glam` ones.
+//!
+//! Rapier and parry are their f64 builds (`rapier2d-f64`, `parry2d-f64`, renamed `rapier2d` and
+//! `parry2d` in `Cargo.toml`). In f32 a position 464 m from the origin is kept to 3e-5 m, and a
+//! substep moving a body less than half of that leaves it where it was: a body the clearance
+//! envelope slowed to a few mm/s at a door's corner never moved again (measured: the rooms
+//! map's campaign run 134, `tests/envelope.rs`). In f64 the same spacing is 6e-14 m.
 
 use nalgebra::Vector2;
 use rapier2d::parry::query::ShapeCastOptions;
@@ -11,24 +17,21 @@ use crate::world::{Agent, WallShape};
 
 /// Rapier vector → control-law vector.
 pub fn from_rapier(v: Vector) -> Vector2<f64> {
-    Vector2::new(f64::from(v.x), f64::from(v.y))
+    Vector2::new(v.x, v.y)
 }
 
 /// Control-law vector → Rapier vector.
 pub fn to_rapier(v: Vector2<f64>) -> Vector {
-    Vector::new(v.x as f32, v.y as f32)
+    Vector::new(v.x, v.y)
 }
 
 /// A Rapier world with the given step whose gravity is the world's external acceleration, m/s²
 /// (Rapier applies `m·a` to every dynamic body).
 pub fn empty_world(dt: f64, external_acceleration: [f64; 2]) -> PhysicsWorld {
     PhysicsWorld {
-        gravity: Vector::new(
-            external_acceleration[0] as f32,
-            external_acceleration[1] as f32,
-        ),
+        gravity: Vector::new(external_acceleration[0], external_acceleration[1]),
         integration_parameters: IntegrationParameters {
-            dt: dt as f32,
+            dt,
             // Rapier keeps a pair's contacts (and their distances) while the pair has moved
             // less than 5 cm since its last full update: a body creeping into a wall would be
             // reported at the distance it had when it was still clear (measured: a touch that
@@ -72,16 +75,12 @@ pub fn insert_agent(
         let r = drive.body_radius;
         let inertia = super::drive::DriveBody::inertia_of(agent);
         let body = RigidBodyBuilder::dynamic()
-            .translation(Vector::new(axle[0] as f32, axle[1] as f32))
-            .rotation(agent.heading as f32)
+            .translation(Vector::new(axle[0], axle[1]))
+            .rotation(agent.heading)
             .can_sleep(false)
             .ccd_enabled(true)
-            .additional_mass_properties(MassProperties::new(
-                Vector::ZERO,
-                agent.mass as f32,
-                inertia as f32,
-            ));
-        let collider = ColliderBuilder::ball(r as f32)
+            .additional_mass_properties(MassProperties::new(Vector::ZERO, agent.mass, inertia));
+        let collider = ColliderBuilder::ball(r)
             .density(0.0)
             .friction(0.0)
             .restitution(0.0);
@@ -89,13 +88,13 @@ pub fn insert_agent(
     }
     let [vx, vy] = agent.initial_velocity;
     let body = RigidBodyBuilder::dynamic()
-        .translation(Vector::new(agent.start[0] as f32, agent.start[1] as f32))
-        .linvel(Vector::new(vx as f32, vy as f32))
+        .translation(Vector::new(agent.start[0], agent.start[1]))
+        .linvel(Vector::new(vx, vy))
         .lock_rotations()
         .can_sleep(false)
         .ccd_enabled(true);
-    let collider = ColliderBuilder::ball(agent.radius as f32)
-        .mass(agent.mass as f32)
+    let collider = ColliderBuilder::ball(agent.radius)
+        .mass(agent.mass)
         .friction(0.0)
         .restitution(0.0);
     physics.insert(body, collider)
@@ -116,15 +115,15 @@ pub fn step_of(physics: &PhysicsWorld, dt: f64) -> Step {
 /// segments. A disc already that near and moving away is clear. (An obstacle moves on during
 /// the step: the envelope keeps a body from driving into one, not one from running into it.)
 pub fn clear_of_walls(physics: &PhysicsWorld, sweep: &Sweep) -> bool {
-    let ball = Ball::new(sweep.radius as f32);
+    let ball = Ball::new(sweep.radius);
     sweep.segments().iter().all(|&(from, to)| {
         let length = (to - from).norm();
         if length <= 0.0 || length.is_nan() {
             return true;
         }
         let options = ShapeCastOptions {
-            max_time_of_impact: length as f32,
-            target_distance: ENVELOPE_MARGIN as f32,
+            max_time_of_impact: length,
+            target_distance: ENVELOPE_MARGIN,
             stop_at_penetration: false,
             compute_impact_geometry_on_penetration: false,
         };
@@ -164,5 +163,25 @@ mod tests {
         assert!((v - (v0 + force / agent.mass * dt)).norm() < 1e-5, "{v}");
         let moved = step_of(&physics, dt).moved(Vector2::new(5.0, 5.0), v0, v);
         assert!((x - moved).norm() < 1e-6, "{x} vs {moved}");
+    }
+
+    /// A body creeping at a few mm/s far from the origin moves as slowly as it goes: where the
+    /// rooms map's campaign run 134 stalled (in f32 positions, 464 m out, it never moved).
+    #[test]
+    fn a_slow_body_far_from_the_origin_moves() {
+        let dt = 0.01;
+        let mut physics = empty_world(dt, [0.0, 0.0]);
+        let text = "size = [500.0, 500.0]\n[field]\ncell = 0.5\n[[agents]]\nname = \"a\"\n\
+                    start = [135.74974, 464.16913]\ntarget = [124.7, 322.5]\n\
+                    initial_velocity = [-0.0027, -0.0047]\n\
+                    controller = { kind = \"nadf\", b = 1.0 }\n";
+        let world = crate::world::load_str(text, std::path::Path::new("w.toml"), &[]).unwrap();
+        let (body, _) = insert_agent(&mut physics, &world.agents[0]);
+        for _ in 0..100 {
+            physics.step();
+        }
+        let x = from_rapier(physics.bodies[body].translation());
+        let moved = Vector2::new(135.74974 - 0.0027, 464.16913 - 0.0047);
+        assert!((x - moved).norm() < 1e-9, "{x} vs {moved}");
     }
 }

@@ -130,18 +130,11 @@ impl ShapedRun {
         };
         let [vx, vy] = agent.initial_velocity;
         let builder = RigidBodyBuilder::dynamic()
-            .pose(ParryPose::new(
-                Vector::new(start[0] as f32, start[1] as f32),
-                start[2] as f32,
-            ))
-            .linvel(Vector::new(vx as f32, vy as f32))
+            .pose(ParryPose::new(Vector::new(start[0], start[1]), start[2]))
+            .linvel(Vector::new(vx, vy))
             .can_sleep(false)
             .ccd_enabled(true)
-            .additional_mass_properties(MassProperties::new(
-                Vector::ZERO,
-                agent.mass as f32,
-                inertia as f32,
-            ));
+            .additional_mass_properties(MassProperties::new(Vector::ZERO, agent.mass, inertia));
         let handle = physics.insert_body(builder);
         let colliders = (shape.polygons().into_iter())
             .map(|polygon| {
@@ -303,7 +296,7 @@ impl ShapedRun {
     /// one by the penetration depth), m. Walls whose bounding box is farther than the nearest so
     /// far (less the shape's reach) are not measured.
     pub fn clearance(&self, walls: &[WallShape], [x, y, theta]: [f64; 3]) -> f64 {
-        let at = ParryPose::new(Vector::new(x as f32, y as f32), theta as f32);
+        let at = ParryPose::new(Vector::new(x, y), theta);
         let polygons = self.shape.polygons();
         let mut nearest = f64::INFINITY;
         for wall in walls {
@@ -318,14 +311,14 @@ impl ShapedRun {
                     wall.shape.as_ref(),
                     0.0,
                 ) {
-                    Ok(Some(contact)) => f64::from(contact.dist),
+                    Ok(Some(contact)) => contact.dist,
                     _ => match parry2d::query::distance(
                         &at,
                         polygon,
                         &wall.pose,
                         wall.shape.as_ref(),
                     ) {
-                        Ok(d) => f64::from(d.distance),
+                        Ok(d) => d.distance,
                         Err(_) => continue,
                     },
                 };
@@ -352,7 +345,7 @@ impl ShapedRun {
                 };
                 for manifold in pair.manifolds() {
                     for c in &manifold.points {
-                        if f64::from(c.dist) <= CONTACT_TOLERANCE {
+                        if c.dist <= CONTACT_TOLERANCE {
                             let local = if mine_first { c.local_p1 } else { c.local_p2 };
                             let on = physics.colliders[collider].position() * local;
                             points.push(from_rapier(on));

@@ -84,14 +84,12 @@ impl BodyShape {
         mass * self.second_moment / self.area
     }
 
-    /// The parts as parry polygons (f32), for Rapier's colliders and parry's queries.
+    /// The parts as parry polygons, for Rapier's colliders and parry's queries.
     pub fn polygons(&self) -> Vec<ConvexPolygon> {
         (self.parts.iter())
             .filter_map(|p| {
                 ConvexPolygon::from_convex_polyline(
-                    p.iter()
-                        .map(|&[x, y]| Vector::new(x as f32, y as f32))
-                        .collect(),
+                    p.iter().map(|&[x, y]| Vector::new(x, y)).collect(),
                 )
             })
             .collect()

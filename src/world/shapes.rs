@@ -23,12 +23,7 @@ impl WallShape {
     /// The wall of `shape` at `pose`.
     pub fn new(pose: Pose, shape: SharedShape) -> Self {
         let aabb = shape.compute_aabb(&pose);
-        let bounds = [
-            f64::from(aabb.mins.x),
-            f64::from(aabb.mins.y),
-            f64::from(aabb.maxs.x),
-            f64::from(aabb.maxs.y),
-        ];
+        let bounds = [aabb.mins.x, aabb.mins.y, aabb.maxs.x, aabb.maxs.y];
         Self {
             pose,
             shape,
@@ -52,10 +47,8 @@ impl WallShape {
 
     /// Distance from a point to the wall, m (0 inside it).
     pub fn distance_to_point(&self, x: f64, y: f64) -> f64 {
-        f64::from(
-            self.shape
-                .distance_to_point(&self.pose, Vector::new(x as f32, y as f32), true),
-        )
+        self.shape
+            .distance_to_point(&self.pose, Vector::new(x, y), true)
     }
 
     /// Signed distance from `(x, y)` to the wall's boundary, m: positive outside, negative
@@ -68,12 +61,9 @@ impl WallShape {
     /// the unit direction in which it grows fastest (away from the boundary outside, towards it
     /// inside; zero on the boundary itself).
     pub fn signed_distance_and_direction(&self, x: f64, y: f64) -> (f64, [f64; 2]) {
-        let p = Vector::new(x as f32, y as f32);
+        let p = Vector::new(x, y);
         let projection = self.shape.project_point(&self.pose, p, false);
-        let away = [
-            f64::from(p.x - projection.point.x),
-            f64::from(p.y - projection.point.y),
-        ];
+        let away = [p.x - projection.point.x, p.y - projection.point.y];
         let d = away[0].hypot(away[1]);
         let sign = if projection.is_inside { -1.0 } else { 1.0 };
         let direction = if d > 0.0 {
@@ -87,23 +77,23 @@ impl WallShape {
 
 /// Converts one wall entry into a shape; `None` when parry cannot build it (a degenerate polygon).
 pub fn wall_shape(wall: &Wall) -> Option<WallShape> {
-    let v = |p: [f64; 2]| Vector::new(p[0] as f32, p[1] as f32);
+    let v = |p: [f64; 2]| Vector::new(p[0], p[1]);
     Some(match wall {
         Wall::Box {
             center,
             half_extents,
             angle,
         } => WallShape::new(
-            Pose::new(v(*center), *angle as f32),
-            SharedShape::cuboid(half_extents[0] as f32, half_extents[1] as f32),
+            Pose::new(v(*center), *angle),
+            SharedShape::cuboid(half_extents[0], half_extents[1]),
         ),
         Wall::Segment { a, b, thickness } => WallShape::new(
             Pose::IDENTITY,
-            SharedShape::capsule(v(*a), v(*b), (*thickness / 2.0) as f32),
+            SharedShape::capsule(v(*a), v(*b), *thickness / 2.0),
         ),
         Wall::Disc { center, radius } => WallShape::new(
             Pose::from_translation(v(*center)),
-            SharedShape::ball(*radius as f32),
+            SharedShape::ball(*radius),
         ),
         Wall::Polygon { points } => WallShape::new(
             Pose::IDENTITY,

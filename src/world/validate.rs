@@ -329,8 +329,8 @@ fn check_arm(
         let hit = named_walls(world).find(|(_, wall)| {
             wall_shape(wall).is_some_and(|w| {
                 let segment = parry2d::shape::Segment::new(
-                    parry2d::math::Vector::new(s[0][0] as f32, s[0][1] as f32),
-                    parry2d::math::Vector::new(s[1][0] as f32, s[1][1] as f32),
+                    parry2d::math::Vector::new(s[0][0], s[0][1]),
+                    parry2d::math::Vector::new(s[1][0], s[1][1]),
                 );
                 parry2d::query::distance(
                     &parry2d::math::Pose::IDENTITY,
@@ -338,7 +338,7 @@ fn check_arm(
                     &w.pose,
                     w.shape.as_ref(),
                 )
-                .is_ok_and(|d| f64::from(d.distance) <= r)
+                .is_ok_and(|d| d.distance <= r)
             })
         });
         if let Some((wall, _)) = hit {
@@ -1261,7 +1261,7 @@ pub fn overlapping_wall(
     [x, y, theta]: [f64; 3],
 ) -> Option<String> {
     use parry2d::math::{Pose, Vector};
-    let at = Pose::new(Vector::new(x as f32, y as f32), theta as f32);
+    let at = Pose::new(Vector::new(x, y), theta);
     let polygons = body.polygons();
     named_walls(world)
         .find(|(_, wall)| {
