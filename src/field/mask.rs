@@ -306,8 +306,8 @@ pub const ON_THE_EDGE: f64 = 1e-9;
 /// `blocked[grid.index(i, j)]` for every cell, for a disc of `radius` metres in the box
 /// `[lo, hi]`, with wall `k`'s boundary moved out by `offsets[k]` metres (in where negative;
 /// missing offsets are zero: the exact walls): the mask of walls sensed with errors. A cell is
-/// blocked when its signed distance to a wall is below `radius + offset` by more than
-/// [`ON_THE_EDGE`].
+/// blocked when its signed distance to a wall is below `radius + offset`, or its distance to
+/// the box's edge below `radius`, by more than [`ON_THE_EDGE`].
 pub fn rasterize(
     grid: &Grid,
     (lo, hi): ([f64; 2], [f64; 2]),
@@ -316,11 +316,11 @@ pub fn rasterize(
     offsets: &[f64],
 ) -> Vec<bool> {
     let mut blocked = vec![false; grid.len()];
+    let inset = radius - ON_THE_EDGE;
     for j in 0..grid.ny {
         for i in 0..grid.nx {
             let [x, y] = grid.center(i, j);
-            if x < lo[0] + radius || y < lo[1] + radius || x > hi[0] - radius || y > hi[1] - radius
-            {
+            if x < lo[0] + inset || y < lo[1] + inset || x > hi[0] - inset || y > hi[1] - inset {
                 blocked[grid.index(i, j)] = true;
             }
         }

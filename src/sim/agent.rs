@@ -896,8 +896,9 @@ impl AgentRun {
             radius: sweep.radius,
         };
         envelope.filter(force, state, self.external, step, |sweep| {
-            // Keeping the margin, or (already nearer: Rapier resolves the step a little differently) no nearer than
-            // it is: a body stopped at the margin may still move along or away.
+            // Keeping the margin, or (already nearer: Rapier resolves a step a little
+            // differently) no nearer than it is: a body stopped at the margin may still move
+            // along or away.
             let apart = sweeps.iter().enumerate().all(|(j, other)| {
                 if j == index || !sweep.near(other, ENVELOPE_MARGIN) {
                     return true;

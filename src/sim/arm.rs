@@ -264,8 +264,8 @@ mod tests {
     use crate::world::{Wall, wall_shape};
 
     /// Rapier's multibody, posed at the same joint angles, has the Lagrangian's joints, and its
-    /// inertia matrix is the Lagrangian's to 1e-5 (the test's tolerance), at configurations spread over the
-    /// joint space.
+    /// inertia matrix is the Lagrangian's to the test's tolerance, at configurations spread over
+    /// the joint space.
     #[test]
     fn rapier_and_the_lagrangian_agree_on_the_inertia_matrix() {
         let c = chain();

@@ -6,8 +6,8 @@
 //! whose metric makes its inertia `m·I` (see `field/space.rs`). The body reads its configuration
 //! and velocity from Rapier in those coordinates and turns a force in them into Rapier's forces
 //! and torques (the one conversion between the laws' nalgebra vectors and Rapier's `glam` ones
-//! is in `physics.rs`; both are f64). [`control`] joins a space and a controller: the guidance at the body's
-//! configuration, the control force, checked for Rapier.
+//! is in `physics.rs`; both are f64). [`control`] joins a space and a controller: the guidance
+//! at the body's configuration, the control force, checked for Rapier.
 //!
 //! - [`DiscBody`]: a disc that does not turn, in the plane (`agent.rs`).
 //! - [`TurningBody`]: a rigid shape that turns, in `(x, y, ρθ)` (`shaped.rs`).

@@ -52,8 +52,11 @@ impl FaultMonitor {
     /// Counts a control force that Rapier could not take (zero was applied instead).
     pub fn rejected_force(&mut self) -> Option<String> {
         self.faults.rejected_forces += 1;
-        (self.faults.rejected_forces == 1)
-            .then(|| "the control force was not finite in f32 (the recording's precision): zero applied instead".to_string())
+        (self.faults.rejected_forces == 1).then(|| {
+            "the control force was not finite in f32 (the recording's precision): zero applied \
+             instead"
+                .to_string()
+        })
     }
 
     /// Records that Rapier's state of the agent became non-finite; it is frozen from now on.
