@@ -248,7 +248,7 @@ fn core_of(wall: &WallShape) -> (Vec<[f64; 2]>, f64) {
     let aabb = shape.compute_aabb(&wall.pose);
     let (a, b) = (aabb.mins, aabb.maxs);
     let corners = [[a.x, a.y], [b.x, a.y], [b.x, b.y], [a.x, b.y]];
-    (corners.map(|[x, y]| [x, y]).to_vec(), 0.0)
+    (corners.to_vec(), 0.0)
 }
 
 /// The convex hull of `{w − p}` for the vertices `w` of `core` and `p` of `part`: the

@@ -65,7 +65,7 @@ impl ArmBodies {
                     link.inertia(),
                 ));
             let handle = physics.insert_body(body);
-            let (a, b) = (-link.com, (link.length - link.com));
+            let (a, b) = (-link.com, link.length - link.com);
             let collider = ColliderBuilder::capsule_from_endpoints(
                 Vector::new(a, 0.0),
                 Vector::new(b, 0.0),
