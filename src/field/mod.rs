@@ -59,7 +59,7 @@ pub use scaled::ScaledW;
 pub use space::ConfigurationSpace;
 pub use streamline::Streamline;
 pub use window::{Reach, Window};
-pub use yielding::{CLEAR_OF_WAY, IN_THE_WAY, WAY_AHEAD, Way};
+pub use yielding::{CLEAR_OF_WAY, IN_THE_WAY, STEP_ASIDE, WAY_AHEAD, Way};
 
 /// The solver's internals, public for the benchmarks only: not part of the crate's API.
 #[doc(hidden)]

@@ -753,14 +753,33 @@ impl AgentRun {
             Vec::new()
         };
         let still_in_the_way = self.yielding && !blocked.is_empty();
+        // And a yielding agent out of the ways waits where its yield took it while its own
+        // target stands in the way of an agent before it: its field would lead it straight back
+        // into that way.
+        let target = Disc {
+            center: self.agent.target,
+            radius: self.agent.radius,
+        };
+        if self.yielding
+            && !stuck
+            && !overrun
+            && blocked.is_empty()
+            && plan.ways.iter().any(|w| w.in_the_way(&target))
+        {
+            return Some(done(field.clone(), None, (true, true)));
+        }
         if !stuck && !overrun && !still_in_the_way {
             return Some(first.and_then(|f| done(f, first_way, (false, false))));
         }
         if !blocked.is_empty() && self.lidar.is_none() {
             let others = (self.offsets.as_slice(), plan.others.as_slice());
-            if let Ok(aside) =
-                HarmonicField::yielding(world, &self.agent, plan.x.into(), others, &blocked)
-            {
+            if let Ok(aside) = HarmonicField::yielding(
+                world,
+                (&self.agent, self.arrived),
+                plan.x.into(),
+                others,
+                &blocked,
+            ) {
                 whole.set(whole.get() + 1);
                 return Some(done(aside, None, (true, true)));
             }
