@@ -33,10 +33,11 @@
 //! on while the walls leave a way, and every agent standing on that way is overrun or stuck
 //! in its way and leaves it, if it has free space to leave into (one that has arrived, within
 //! [`STEP_ASIDE`] of its target). So it arrives in finite time and drops to the second group;
-//! the order changes at most once per agent, and the argument repeats for the next. The clearance envelope holds under all of it (a yield is only another
-//! field), so no one touches on the way. What the rule cannot do is make room where there is
-//! none: an agent with no free cell clear of the ways that it can reach keeps its field and
-//! waits, and the run reports whom that left short of the target.
+//! the order changes at most once per agent, and the argument repeats for the next. The
+//! clearance envelope holds under all of it (a yield is only another field), so no one touches
+//! on the way. What the rule cannot do is make room where there is none: an agent with no free
+//! cell clear of the ways that it can reach keeps its field and waits, and the run reports whom
+//! that left short of the target.
 
 use std::sync::Arc;
 
@@ -188,13 +189,14 @@ impl HarmonicField {
     /// free cell connected to it and clear of the ways (see [`FreeSpace::out_of_ways`]), so it
     /// leads to the nearest of them by the harmonic field's own argument (no local minimum).
     ///
-    /// Its `target` is where that descent ends ([`HarmonicField::yield_point`]), with no
-    /// target disc: the control law's offset, and with it the guidance's taper, a brake and
-    /// a clamp, is measured to where the field leads. Were it the agent's own target, an
-    /// agent that had arrived there would yield with no force at all: the guidance tapers to
-    /// zero on the target and the gradient is the target's bowl within its rim (measured: two
-    /// groups of 8 swapping through a door at 1.2 m of arc, the first arrivals parked a robot's
-    /// width apart, overrun and yielding in name for 100 s; 6 of 16 robots reached).
+    /// Its `target` is where that descent ends (its streamline from `position` to the first
+    /// cells clear of the ways, where `W = 1` and the gradient vanishes), with no target disc:
+    /// the control law's offset, and with it the guidance's taper, a brake and a clamp, is
+    /// measured to where the field leads. Were it the agent's own target, an agent that had
+    /// arrived there would yield with no force at all: the guidance tapers to zero on the
+    /// target and the gradient is the target's bowl within its rim (measured: two groups of 8
+    /// swapping through a door at 1.2 m of arc, the first arrivals parked a robot's width
+    /// apart, overrun and yielding in name for 100 s; 6 of 16 robots reached).
     ///
     /// [`FieldError::Unreachable`] when there is nowhere to go (for an agent that has
     /// `arrived`, nowhere within [`STEP_ASIDE`] of its target).
@@ -221,7 +223,7 @@ impl HarmonicField {
     /// Where the descent of this yielding field from `position` ends: the first point of the
     /// cells clear of the ways that its streamline reaches (where `W = 1` and the gradient
     /// vanishes); `position` itself when it is clear already.
-    pub fn yield_point(&self, position: [f64; 2]) -> [f64; 2] {
+    fn yield_point(&self, position: [f64; 2]) -> [f64; 2] {
         let grid = self.grid();
         // No target point to stop at, and no target's bowl: the gradient as solved.
         let line = super::streamline::integrate(
