@@ -259,6 +259,29 @@ fn orca_crosses_the_circle_too() {
     assert!(closest(&orca) >= 0.0 && closest(&nadf) >= 0.0);
 }
 
+/// Runs the crowd `name` to the end: the agents' summaries, and every step aside (the rule's
+/// note) as the agent's index with whether it had arrived (come within its settling band)
+/// before that step.
+fn run_noting_steps_aside(name: &str) -> (Vec<nadf::metrics::Summary>, Vec<(usize, bool)>) {
+    let world = common::world(name, &[]);
+    let mut sim = nadf::sim::Simulation::new(&world).unwrap();
+    let band = sim.agents[0].metrics.band();
+    let mut arrived = vec![false; world.agents.len()];
+    let mut steps_aside = Vec::new();
+    while !sim.finished() {
+        for (k, state) in sim.step().into_iter().enumerate() {
+            if state.notes.iter().any(|n| n.contains("steps aside")) {
+                steps_aside.push((k, arrived[k]));
+            }
+            arrived[k] |= state.distance <= band;
+        }
+    }
+    (
+        sim.agents.iter().map(|a| a.summary()).collect(),
+        steps_aside,
+    )
+}
+
 /// Two groups of eight swap sides through a 2 m door (`crowds/door-16.toml`). Each group closes
 /// the door for the other, so every field is cut off when they meet in it; without the rule of
 /// giving way (`src/field/yielding.rs`) the first robots in stop face to face for good (measured
@@ -266,25 +289,16 @@ fn orca_crosses_the_circle_too() {
 /// some robots stepped aside on the way.
 #[test]
 fn two_groups_swap_through_a_door_by_giving_way() {
-    let world = common::world("crowds/door-16.toml", &[]);
-    let mut sim = nadf::sim::Simulation::new(&world).unwrap();
-    let mut stepped_aside = std::collections::BTreeSet::new();
-    let band = sim.agents[0].metrics.band();
-    let mut first_arrived = false;
-    while !sim.finished() {
-        for (k, state) in sim.step().into_iter().enumerate() {
-            if state.notes.iter().any(|n| n.contains("steps aside")) {
-                // The first robot never gives way before it has arrived (the rule's argument).
-                assert!(k != 0 || first_arrived, "r00 stepped aside on its way");
-                stepped_aside.insert(k);
-            }
-            first_arrived |= k == 0 && state.distance <= band;
-        }
+    let (summaries, steps_aside) = run_noting_steps_aside("crowds/door-16.toml");
+    // The first robot never gives way before it has arrived (the rule's argument).
+    for &(k, arrived) in &steps_aside {
+        assert!(k != 0 || arrived, "r00 stepped aside on its way");
     }
-    let summaries: Vec<_> = sim.agents.iter().map(|a| a.summary()).collect();
     for s in &summaries {
         assert!(s.reached && s.contacts == 0, "{s:?}");
     }
+    let stepped_aside: std::collections::BTreeSet<_> =
+        steps_aside.iter().map(|&(k, _)| k).collect();
     let last = (summaries.iter())
         .filter_map(|s| s.settling_time)
         .fold(0.0, f64::max);
@@ -303,23 +317,15 @@ fn two_groups_swap_through_a_door_by_giving_way() {
 /// arrived step aside.
 #[test]
 fn robots_parked_on_their_targets_step_aside_for_the_later_ones() {
-    let world = common::world("crowds/door-16-arc-1.2.toml", &[]);
-    let mut sim = nadf::sim::Simulation::new(&world).unwrap();
-    let band = sim.agents[0].metrics.band();
-    let mut arrived = vec![false; world.agents.len()];
-    let mut stepped_off = std::collections::BTreeSet::new();
-    while !sim.finished() {
-        for (k, state) in sim.step().into_iter().enumerate() {
-            if arrived[k] && state.notes.iter().any(|n| n.contains("steps aside")) {
-                stepped_off.insert(k);
-            }
-            arrived[k] |= state.distance <= band;
-        }
-    }
-    for s in sim.agents.iter().map(|a| a.summary()) {
+    let (summaries, steps_aside) = run_noting_steps_aside("crowds/door-16-arc-1.2.toml");
+    for s in &summaries {
         assert!(s.reached && s.contacts == 0, "{s:?}");
         assert!(s.min_separation.is_some_and(|d| d > 0.0), "{s:?}");
     }
+    let stepped_off: std::collections::BTreeSet<_> = (steps_aside.iter())
+        .filter(|&&(_, arrived)| arrived)
+        .map(|&(k, _)| k)
+        .collect();
     eprintln!("door-16-arc-1.2: robots that stepped off their targets: {stepped_off:?}");
     assert!(!stepped_off.is_empty());
 }

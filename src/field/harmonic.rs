@@ -375,7 +375,7 @@ impl HarmonicField {
     }
 
     /// The interpolated gradient of the solved cells at `p` (see [`HarmonicField::gradient`]).
-    pub(super) fn sampled_gradient(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
+    fn sampled_gradient(&self, p: [f64; 2]) -> Option<Vector2<f64>> {
         let (g, e) = self.sampler_at(p).grad_w_scaled(p)?;
         let true_size = g.map(|c| ldexp(c, e));
         let size = g.norm();

@@ -46,7 +46,6 @@ use super::laplace;
 use super::mask::{Disc, FreeSpace};
 use super::streamline::Streamline;
 use super::{FieldError, HarmonicField};
-use crate::control::unit;
 use crate::world::{Agent, World};
 
 /// How much of its guidance an agent publishes as its way, m: the next few seconds at a
@@ -215,26 +214,17 @@ impl HarmonicField {
                 radius: agent.radius,
             })?;
         let mut field = Self::solve_space(world, agent, space, (None, None), started)?;
-        field.target = field.yield_point(position);
+        // Its streamline with no target point (none to stop at, no target's bowl) is the plain
+        // descent: where it ends, in the cells clear of the ways (`W = 1`, no gradient), is the
+        // target; `position` itself when it is clear already.
+        field.target = [f64::INFINITY; 2];
         field.target_radius = 0.0;
+        field.target = *field
+            .streamline(position)
+            .points
+            .last()
+            .unwrap_or(&position);
         Ok(field)
-    }
-
-    /// Where the descent of this yielding field from `position` ends: the first point of the
-    /// cells clear of the ways that its streamline reaches (where `W = 1` and the gradient
-    /// vanishes); `position` itself when it is clear already.
-    fn yield_point(&self, position: [f64; 2]) -> [f64; 2] {
-        let grid = self.grid();
-        // No target point to stop at, and no target's bowl: the gradient as solved.
-        let line = super::streamline::integrate(
-            |p| self.sampled_gradient(p).and_then(|g| unit(&-g)),
-            position,
-            [f64::INFINITY; 2],
-            0.5 * grid.cell,
-            grid.cell,
-            4.0 * (grid.nx * grid.ny) as f64 * grid.cell,
-        );
-        *line.points.last().unwrap_or(&position)
     }
 }
 
