@@ -47,14 +47,18 @@ use crate::world::Agent;
 ///   difference from a full re-solve, degrees of guidance near the others, is far above what a
 ///   tighter solve changes, and it takes about a third fewer iterations than 1e-12. Cells below
 ///   what the solve resolves go to the nested levels, as in a full solve.
+/// - A replan that sets the very problem the last one solved (an agent parked among parked
+///   neighbours, while its coarse window is reused) is served that solution, which is the
+///   solve's to the bit (see `Solved`).
 /// - An agent that the others cut off, or whose every way on they block within the window
 ///   (every ring cell it can reach has a lower `W` of the walls than it has, and no target cell),
 ///   gets [`FieldError::Unreachable`]: whether a detour exists beyond the window only a full
 ///   re-solve can say, and the simulation falls back to one for that replan.
 #[derive(Debug, Clone)]
 pub struct Window {
-    /// The window's cells, a part of the agent's grid.
-    sampler: Sampler,
+    /// The window's problem and its field, on a part of the agent's grid (shared with the next
+    /// replan when that sets the same problem: see [`Solved`]).
+    solved: Arc<Solved>,
     /// Where samples are read from the window: the points whose interpolation stencil lies at
     /// least one cell inside its edge (central differences there read only window cells), as
     /// fractional cell coordinates `[lo, hi)` along x and y.
@@ -73,6 +77,7 @@ pub struct Window {
 
 /// A Dirichlet problem on a window: which cells the agent's centre may be in, which hold
 /// fixed values, and the values (fixed ones, and the starting guess of the others).
+#[derive(Debug)]
 struct Problem {
     grid: Grid,
     /// Free: the field of the walls reaches it and no disc covers it.
@@ -96,6 +101,62 @@ impl Problem {
                 exponent: vec![0; n],
             },
         }
+    }
+
+    /// Whether `other` is this problem to the bit (`-0.0` is not `0.0` here: the solve is a
+    /// function of the bits).
+    fn same_as(&self, other: &Self) -> bool {
+        self.grid == other.grid
+            && self.free == other.free
+            && self.known == other.known
+            && self.values.exponent == other.values.exponent
+            && (self.values.mantissa.iter().map(|m| m.to_bits())).eq(other
+                .values
+                .mantissa
+                .iter()
+                .map(|m| m.to_bits()))
+    }
+}
+
+/// A window's problem with its solution. The solve is a function of the problem, the agent's
+/// cell in it and where its nested levels stop alone, so a replan that sets the very same
+/// problem is served this solution, which is the solve's to the bit: an agent settled among
+/// settled neighbours sets the same fine problem at every replan while its coarse window is
+/// reused, and the same coarse problem while nothing in its reach moves by a cell.
+#[derive(Debug)]
+struct Solved {
+    problem: Problem,
+    /// The agent's cell in the problem's grid.
+    at: Option<(usize, usize)>,
+    stop: Stop,
+    sampler: Sampler,
+}
+
+impl Solved {
+    /// `problem` solved for the agent at `position` (see `solve_problem`), or `previous` when
+    /// that set the same problem with the agent in the same cell and the same `stop`. Returns
+    /// the iterations done (0 when served).
+    fn solve(
+        problem: Problem,
+        agent: &Agent,
+        position: [f64; 2],
+        (tolerance, stop): (f64, Stop),
+        previous: Option<&Arc<Solved>>,
+    ) -> Result<(Arc<Self>, usize), FieldError> {
+        let at = problem.grid.cell_of(position);
+        if let Some(p) = previous.filter(|p| p.at == at && p.stop == stop)
+            && p.problem.same_as(&problem)
+        {
+            return Ok((Arc::clone(p), 0));
+        }
+        let (sampler, iterations) = solve_problem(&problem, agent, position, tolerance, &stop)?;
+        let solved = Self {
+            problem,
+            at,
+            stop,
+            sampler,
+        };
+        Ok((Arc::new(solved), iterations))
     }
 }
 
@@ -131,7 +192,7 @@ pub enum Reach {
 /// A coarse window, and how it was made.
 #[derive(Debug)]
 struct Coarse {
-    sampler: Arc<Sampler>,
+    solved: Arc<Solved>,
     /// Whether it covers the whole grid ([`Reach::Whole`]): such a window is never reused.
     whole: bool,
     /// Where the agent was when it was solved, m.
@@ -191,7 +252,8 @@ impl Window {
                 (d.center[0] - position[0]).abs() < r && (d.center[1] - position[1]).abs() < r
             })
             .collect();
-        let reusable = (previous.and_then(|p| p.coarse.as_ref())).filter(|c| {
+        let last_coarse = previous.and_then(|p| p.coarse.as_ref());
+        let reusable = last_coarse.filter(|c| {
             !whole
                 && !c.whole
                 && c.reused < COARSE_REUSE
@@ -200,7 +262,7 @@ impl Window {
         let mut coarse_iterations = 0;
         let coarse = match reusable {
             Some(c) => Some(Arc::new(Coarse {
-                sampler: Arc::clone(&c.sampler),
+                solved: Arc::clone(&c.solved),
                 whole: false,
                 centre: c.centre,
                 reused: c.reused + 1,
@@ -211,11 +273,12 @@ impl Window {
                 // when it covers the whole grid): its levels stop once those cells are solved.
                 let serves = if whole { 0.0 } else { 0.25 * reach };
                 let read = read_by_rings((&problem.grid, grid), position, half, serves);
-                match solve_problem(problem, agent, position, tolerance, &read) {
-                    Ok((sampler, iterations)) => {
+                let last = last_coarse.map(|c| &c.solved);
+                match Solved::solve(problem, agent, position, (tolerance, read), last) {
+                    Ok((solved, iterations)) => {
                         coarse_iterations = iterations;
                         Some(Arc::new(Coarse {
-                            sampler: Arc::new(sampler),
+                            solved,
                             whole,
                             centre: position,
                             reused: 0,
@@ -261,7 +324,7 @@ impl Window {
                 && problem.free[k]
                 && let Some(coarse) = &coarse
             {
-                match coarse.sampler.w_scaled(centre) {
+                match coarse.solved.sampler.w_scaled(centre) {
                     Some((m, e)) if m > 0.0 => {
                         (problem.values.mantissa[k], problem.values.exponent[k]) = (m, e);
                     }
@@ -286,11 +349,12 @@ impl Window {
         if !whole && !leads_on(&problem, (grid, reachable, w), (&ir, &jr), position) {
             return Err(unreachable());
         }
-        let (sampler, iterations) =
-            solve_problem(problem, agent, position, tolerance, &Stop::Never)?;
+        let last = previous.map(|p| &p.solved);
+        let (solved, iterations) =
+            Solved::solve(problem, agent, position, (tolerance, Stop::Never), last)?;
         let interior = [[1.0, local.nx as f64 - 2.0], [1.0, local.ny as f64 - 2.0]];
         Ok(Self {
-            sampler,
+            solved,
             interior,
             discs: discs.len(),
             coarse,
@@ -301,12 +365,12 @@ impl Window {
 
     /// The window's field.
     pub fn sampler(&self) -> &Sampler {
-        &self.sampler
+        &self.solved.sampler
     }
 
     /// The window's cells.
     pub fn grid(&self) -> &Grid {
-        self.sampler.grid()
+        self.solved.sampler.grid()
     }
 
     /// Whether samples at `p` are read from the window: its interior, where the interpolation
@@ -412,7 +476,7 @@ fn coarse_problem(
 /// The nested levels may `stop` short of every cell (see [`Stop`]). Returns the sampler and
 /// the iterations; an error when the agent at `position` is cut off.
 fn solve_problem(
-    problem: Problem,
+    problem: &Problem,
     agent: &Agent,
     position: [f64; 2],
     tolerance: f64,
@@ -428,6 +492,7 @@ fn solve_problem(
         agent: agent.name.clone(),
         radius: agent.radius,
     };
+    let local = *local;
     let n = local.len();
     let mut connected = vec![false; n];
     let mut stack: Vec<usize> = (0..n)
@@ -597,6 +662,7 @@ mod tests {
             })
             .collect();
         let coarse = |f: &HarmonicField| f.window.as_ref().unwrap().coarse.clone().unwrap();
+        let sampler = |f: &HarmonicField| Arc::clone(&coarse(f).solved);
         let settings = crate::world::FieldSettings {
             replan_reach: 4.0,
             ..world.field.clone()
@@ -605,7 +671,7 @@ mod tests {
             .with_wide_window(agent, agent.start, &others, &settings)
             .unwrap()
             .unwrap();
-        let covered = coarse(&wide).sampler.grid().len() * COARSE * COARSE;
+        let covered = sampler(&wide).sampler.grid().len() * COARSE * COARSE;
         assert!(
             coarse(&wide).whole && covered >= walls.grid().len(),
             "{covered}"
@@ -617,8 +683,51 @@ mod tests {
         let again = next
             .with_window(agent, agent.start, &others, &settings)
             .unwrap();
-        assert!(Arc::ptr_eq(&coarse(&next).sampler, &coarse(&again).sampler));
+        assert!(Arc::ptr_eq(&sampler(&next), &sampler(&again)));
         assert_eq!(coarse(&again).reused, 1);
+    }
+
+    /// A replan that sets the very problem of the last one (the same discs, the agent where it
+    /// was, the coarse window reused) is served the last solution, solving nothing; one disc
+    /// moved by two cells makes a new problem, which is solved.
+    #[test]
+    fn a_replan_that_sets_the_same_problem_is_served_the_last_solution() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/crowds/circle-16.toml");
+        let world = crate::world::load(&path, &[]).unwrap();
+        let agent = &world.agents[0];
+        let walls = HarmonicField::solve(&world, agent).unwrap();
+        // Two robots a metre or so down the agent's guidance.
+        let g = walls.gradient(agent.start).unwrap().normalize();
+        let ahead = |d: f64, s: f64| Disc {
+            center: [
+                agent.start[0] - d * g.x - s * g.y,
+                agent.start[1] - d * g.y + s * g.x,
+            ],
+            radius: agent.radius,
+        };
+        let others = [ahead(1.2, 0.3), ahead(2.0, -0.5)];
+        let window = |f: &HarmonicField| Arc::clone(f.window.as_ref().unwrap());
+        let first = walls
+            .with_window(agent, agent.start, &others, &world.field)
+            .unwrap();
+        assert!(window(&first).iterations > 0);
+        let again = first
+            .with_window(agent, agent.start, &others, &world.field)
+            .unwrap();
+        assert!(Arc::ptr_eq(&window(&first).solved, &window(&again).solved));
+        assert_eq!(window(&again).iterations, 0);
+        let moved = [ahead(1.2, 0.3 + 2.0 * world.field.cell), ahead(2.0, -0.5)];
+        let next = again
+            .with_window(agent, agent.start, &moved, &world.field)
+            .unwrap();
+        assert!(!Arc::ptr_eq(&window(&again).solved, &window(&next).solved));
+        assert!(window(&next).iterations > 0);
+        let (a, b) = (
+            again.gradient(agent.start).unwrap(),
+            next.gradient(agent.start).unwrap(),
+        );
+        assert_ne!(a, b);
     }
 
     /// The box a coarse window's levels stop at holds every cell that a ring of a fine window
