@@ -1,7 +1,9 @@
-//! Nearest-item queries among many items (a map's walls, a long path's segments): the items'
-//! bounding boxes in buckets of a coarse grid, searched ring by ring outwards from the query
-//! point until no farther bucket can hold a nearer item. The distances are whatever the caller
-//! measures, so the nearest is exactly the one a scan of every item finds.
+//! Nearest-item queries among many items (a map's walls, measured from a body near them at
+//! every step): the items' bounding boxes in buckets of a coarse grid, searched ring by ring
+//! outwards from the query point until no farther bucket can hold a nearer item. The distances
+//! are whatever the caller measures, so the nearest is exactly the one a scan of every item
+//! finds. (A point far from every item visits every empty bucket on its way: a path's segments,
+//! measured from states metres off it, are in a tree instead: `field/segment_tree.rs`.)
 
 /// Items by bucket of a grid over their bounding boxes.
 #[derive(Debug, Clone)]

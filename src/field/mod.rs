@@ -38,6 +38,7 @@ mod nested;
 mod pose;
 mod sample;
 mod scaled;
+mod segment_tree;
 mod space;
 mod streamline;
 mod window;

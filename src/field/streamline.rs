@@ -3,7 +3,7 @@
 
 use nalgebra::Vector2;
 
-use crate::buckets::Buckets;
+use super::segment_tree::SegmentTree;
 
 /// A polyline from the start towards the target.
 #[derive(Debug, Clone, PartialEq)]
@@ -66,8 +66,8 @@ impl Streamline {
 
     /// The largest distance from any of `points` to the polyline, m (0 for none): `δ_m` of a
     /// path. The same value as [`Streamline::distance_to`] at every point, but a long run
-    /// against a long path (300,000 states against 44,000 segments through a maze) buckets
-    /// the segments and searches outwards from each point, ring by ring.
+    /// against a long path (300,000 states against 44,000 segments through a maze) finds each
+    /// point's nearest segments in a tree of the path's runs (`segment_tree.rs`).
     ///
     /// The distance to the polyline moves by at most as far as the point does (it is
     /// 1-Lipschitz), so a point nearer to the last one measured than that one's distance falls
@@ -76,15 +76,12 @@ impl Streamline {
     /// robot, metres off its path, ring by ring. The result is the scan's to the bit: a point
     /// is skipped only with a nanometre to spare, far above the rounding of a distance.
     pub fn max_distance(&self, points: &[[f64; 2]]) -> f64 {
-        let buckets = if self.points.len() < 64 || points.len() < 64 {
-            None
-        } else {
-            self.segment_buckets()
-        };
-        let measure = |p: &[f64; 2]| match &buckets {
-            Some(buckets) => {
+        let tree =
+            (self.points.len() >= 64 && points.len() >= 64).then(|| SegmentTree::new(&self.points));
+        let measure = |p: &[f64; 2]| match &tree {
+            Some(tree) => {
                 let q = Vector2::from(*p);
-                buckets.nearest(*p, |s, best| best.min(self.segment_distance(s, q)))
+                tree.nearest(*p, |s| self.segment_distance(s, q))
             }
             None => self.distance_to(*p),
         };
@@ -101,25 +98,6 @@ impl Streamline {
             last = Some((*p, d));
         }
         max
-    }
-
-    /// The segments in buckets of about four steps of the path.
-    fn segment_buckets(&self) -> Option<Buckets> {
-        let boxes: Vec<[f64; 4]> = self
-            .points
-            .windows(2)
-            .map(|s| {
-                let [a, b] = [s[0], s[1]];
-                [
-                    a[0].min(b[0]),
-                    a[1].min(b[1]),
-                    a[0].max(b[0]),
-                    a[1].max(b[1]),
-                ]
-            })
-            .collect();
-        let size = self.length() / boxes.len() as f64 * 4.0;
-        Buckets::new(&boxes, size.max(1e-9))
     }
 
     /// Distance from `p` to segment `s` (from point `s` to point `s + 1`), m.
@@ -178,10 +156,10 @@ mod tests {
 mod index {
     use super::*;
 
-    /// A long winding path against points all around it: the bucketed search gives every
+    /// A long winding path against points all around it: the tree's search gives every
     /// point's distance to the bit, so `δ_m` too.
     #[test]
-    fn the_bucketed_distance_is_the_scanned_one() {
+    fn the_tree_searched_distance_is_the_scanned_one() {
         let points: Vec<[f64; 2]> = (0..3000)
             .map(|k| {
                 let t = k as f64 * 0.01;
@@ -195,11 +173,11 @@ mod index {
         let probes: Vec<[f64; 2]> = (0..4000)
             .map(|k| [-5.0 + (k % 80) as f64 * 1.4, -6.0 + (k / 80) as f64 * 0.37])
             .collect();
-        let buckets = line.segment_buckets().unwrap();
+        let tree = SegmentTree::new(&line.points);
         for p in &probes {
             let scan = line.distance_to(*p);
             let q = Vector2::from(*p);
-            let fast = buckets.nearest(*p, |s, best| best.min(line.segment_distance(s, q)));
+            let fast = tree.nearest(*p, |s| line.segment_distance(s, q));
             assert_eq!(scan.to_bits(), fast.to_bits(), "at {p:?}");
         }
         let scanned = probes
