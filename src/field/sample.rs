@@ -31,46 +31,40 @@ impl Stencil {
 /// cell to take its guidance from.
 pub(super) const NEAR: i64 = 3;
 
-/// `W` and its central-difference gradient at every cell centre, ready for interpolation.
+/// `W` at every cell centre, ready for interpolation, with its central-difference gradient.
 #[derive(Debug, Clone)]
 pub struct Sampler {
     grid: Grid,
     w: ScaledW,
-    /// `∇W` at each cell centre, at that cell's scale `2^exponent`.
-    grad_w: Vec<Vector2<f64>>,
     reachable: Vec<bool>,
 }
 
 impl Sampler {
-    /// Precomputes central differences of `w` (blocked and off-grid neighbours count as the
-    /// boundary value 0), each at its cell's scale.
+    /// The sampler of `w` on `grid`, over its `reachable` cells.
     pub fn new(grid: Grid, w: ScaledW, reachable: Vec<bool>) -> Self {
-        let mut grad_w = vec![Vector2::zeros(); grid.len()];
-        for j in 0..grid.ny {
-            for i in 0..grid.nx {
-                let k = grid.index(i, j);
-                if reachable[k] {
-                    let e = w.exponent[k];
-                    let at = |i: isize, j: isize| {
-                        if i < 0 || j < 0 || i >= grid.nx as isize || j >= grid.ny as isize {
-                            0.0
-                        } else {
-                            w.at_scale(grid.index(i as usize, j as usize), e)
-                        }
-                    };
-                    let (i, j) = (i as isize, j as isize);
-                    grad_w[k] =
-                        Vector2::new(at(i + 1, j) - at(i - 1, j), at(i, j + 1) - at(i, j - 1))
-                            / (2.0 * grid.cell);
-                }
+        Self { grid, w, reachable }
+    }
+
+    /// `∇W` at the centre of cell `k` by central differences (blocked and off-grid neighbours
+    /// count as the boundary value 0), at that cell's scale `2^exponent`; 0 where `k` is not
+    /// reachable. Computed where it is read: a sample reads four cells, while a field has
+    /// millions, most never read (kept for every cell, it was 16 bytes a cell of every field
+    /// and window, and a pass over them all at each solve).
+    fn grad_at(&self, k: usize) -> Vector2<f64> {
+        if !self.reachable[k] {
+            return Vector2::zeros();
+        }
+        let (grid, w) = (&self.grid, &self.w);
+        let e = w.exponent[k];
+        let at = |i: isize, j: isize| {
+            if i < 0 || j < 0 || i >= grid.nx as isize || j >= grid.ny as isize {
+                0.0
+            } else {
+                w.at_scale(grid.index(i as usize, j as usize), e)
             }
-        }
-        Self {
-            grid,
-            w,
-            grad_w,
-            reachable,
-        }
+        };
+        let (i, j) = ((k % grid.nx) as isize, (k / grid.nx) as isize);
+        Vector2::new(at(i + 1, j) - at(i - 1, j), at(i, j + 1) - at(i, j - 1)) / (2.0 * grid.cell)
     }
 
     /// The bilinear weights of the (up to four) reachable cell centres around `p`, renormalized
@@ -163,8 +157,8 @@ impl Sampler {
         let s = s.cells();
         let e = self.scale(s);
         let at_scale = |k: usize| match self.w.exponent[k] - e {
-            0 => self.grad_w[k],
-            shift => self.grad_w[k].map(|c| ldexp(c, shift)),
+            0 => self.grad_at(k),
+            shift => self.grad_at(k).map(|c| ldexp(c, shift)),
         };
         (!s.is_empty()).then(|| (s.iter().map(|&(k, a)| at_scale(k) * a).sum(), e))
     }
