@@ -13,8 +13,9 @@ still making progress), the last settling time, and the wall time against the si
 
 Worlds (radius 0.3 m, 1 kg, K = 1 N normalized, B_d = 10, 2 m/s, 0.1 m cells, 10 Hz local
 replanning, as the shipped circles):
-- circle: `n` robots evenly on a circle with `arc` metres of it each, each to the antipode,
-  its target turned by 0.05 rad and its start angle jittered by up to ±0.01 rad by the seed;
+- circle: `n` robots evenly on a circle with `arc` metres of it each (its radius at least 2 m),
+  each to the antipode, its target turned by 0.05 rad and its start angle jittered by up to
+  ±0.01 rad by the seed;
 - crossing: two flows of n/2 robots at right angles through the centre of a square room,
   `arc` metres apart in each flow;
 - door: two groups of n/2 robots swapping sides of a room through a 2 m door in a wall.
@@ -58,7 +59,7 @@ def agent(k, start, target, kind):
 
 def circle(n, arc, seed, kind):
     rng = random.Random(seed)
-    radius = max(n * arc / math.tau, 4.8)
+    radius = max(n * arc / math.tau, 2.0)
     size = 2 * radius + 2.4
     c = size / 2
     text = header(f"circle-{n}-{arc}-{seed}", size, 2 * radius + 40)
