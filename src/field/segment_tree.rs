@@ -130,13 +130,12 @@ fn box_distance(b: &[f64; 4], p: [f64; 2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::field::streamline::segment_distance;
+    use nalgebra::Vector2;
 
-    /// Distance from `p` to the segment from `a` to `b`.
+    /// Distance from `p` to the segment from `a` to `b` (the path's own measure).
     fn to_segment(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
-        let (ab, ap) = ([b[0] - a[0], b[1] - a[1]], [p[0] - a[0], p[1] - a[1]]);
-        let len2 = (ab[0] * ab[0] + ab[1] * ab[1]).max(f64::MIN_POSITIVE);
-        let t = ((ap[0] * ab[0] + ap[1] * ab[1]) / len2).clamp(0.0, 1.0);
-        (ap[0] - t * ab[0]).hypot(ap[1] - t * ab[1])
+        segment_distance(a, b, Vector2::from(p))
     }
 
     /// A long winding path that crosses itself, against points on it, near it and tens of

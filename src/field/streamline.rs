@@ -128,7 +128,7 @@ pub(super) fn polyline_distance(points: &[[f64; 2]], p: [f64; 2]) -> f64 {
 }
 
 /// Distance from `p` to the segment from `a` to `b`, m.
-fn segment_distance(a: [f64; 2], b: [f64; 2], p: Vector2<f64>) -> f64 {
+pub(super) fn segment_distance(a: [f64; 2], b: [f64; 2], p: Vector2<f64>) -> f64 {
     let (a, b) = (Vector2::from(a), Vector2::from(b));
     let ab = b - a;
     let t = ((p - a).dot(&ab) / ab.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);

@@ -644,17 +644,23 @@ mod tests {
     use super::*;
     use crate::field::HarmonicField;
 
+    /// `worlds/crowds/circle-16.toml` and its first agent's field of the walls.
+    fn circle_16() -> (crate::world::World, HarmonicField) {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/crowds/circle-16.toml");
+        let world = crate::world::load(&path, &[]).unwrap();
+        let walls = HarmonicField::solve(&world, &world.agents[0]).unwrap();
+        (world, walls)
+    }
+
     /// A wide window's coarse window covers the whole grid and never serves a later window
     /// (the field among the others over the whole grid, held as the edge of the next windows,
     /// milled crossing flows about for good: see the commit that reverted that reuse); an
     /// ordinary coarse window serves the next replan.
     #[test]
     fn a_wide_windows_coarse_window_covers_the_grid_and_is_not_reused() {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/crowds/circle-16.toml");
-        let world = crate::world::load(&path, &[]).unwrap();
+        let (world, walls) = circle_16();
         let agent = &world.agents[0];
-        let walls = HarmonicField::solve(&world, agent).unwrap();
         let others: Vec<Disc> = (world.agents[1..].iter())
             .map(|a| Disc {
                 center: a.start,
@@ -662,7 +668,7 @@ mod tests {
             })
             .collect();
         let coarse = |f: &HarmonicField| f.window.as_ref().unwrap().coarse.clone().unwrap();
-        let sampler = |f: &HarmonicField| Arc::clone(&coarse(f).solved);
+        let solved = |f: &HarmonicField| Arc::clone(&coarse(f).solved);
         let settings = crate::world::FieldSettings {
             replan_reach: 4.0,
             ..world.field.clone()
@@ -671,7 +677,7 @@ mod tests {
             .with_wide_window(agent, agent.start, &others, &settings)
             .unwrap()
             .unwrap();
-        let covered = sampler(&wide).sampler.grid().len() * COARSE * COARSE;
+        let covered = solved(&wide).sampler.grid().len() * COARSE * COARSE;
         assert!(
             coarse(&wide).whole && covered >= walls.grid().len(),
             "{covered}"
@@ -683,7 +689,7 @@ mod tests {
         let again = next
             .with_window(agent, agent.start, &others, &settings)
             .unwrap();
-        assert!(Arc::ptr_eq(&sampler(&next), &sampler(&again)));
+        assert!(Arc::ptr_eq(&solved(&next), &solved(&again)));
         assert_eq!(coarse(&again).reused, 1);
     }
 
@@ -692,11 +698,8 @@ mod tests {
     /// moved by two cells makes a new problem, which is solved.
     #[test]
     fn a_replan_that_sets_the_same_problem_is_served_the_last_solution() {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/crowds/circle-16.toml");
-        let world = crate::world::load(&path, &[]).unwrap();
+        let (world, walls) = circle_16();
         let agent = &world.agents[0];
-        let walls = HarmonicField::solve(&world, agent).unwrap();
         // Two robots a metre or so down the agent's guidance.
         let g = walls.gradient(agent.start).unwrap().normalize();
         let ahead = |d: f64, s: f64| Disc {
