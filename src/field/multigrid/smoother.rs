@@ -5,6 +5,102 @@
 use super::kernels::Neighbourhood;
 use super::level::{Level, Stencil};
 
+/// Cells a short row's update computes at once: one AVX2 register of f32.
+const LANES: usize = 8;
+
+/// Rows at least this long are updated through a buffer (see [`in_place`]).
+const LONG_ROW: usize = 256;
+
+/// Gauss-Seidel's new values `out` of the cells from padded index `o` (row position `i`, for
+/// `keep`) on the finest level's uniform stencil, from `x`; `keep`'s cells keep their value.
+#[inline(always)]
+fn uniform(
+    out: &mut [f32],
+    x: &[f32],
+    (b, d, keep): (&[f32], &[f32], &[f32]),
+    (o, i): (usize, usize),
+    s: usize,
+) {
+    let n = out.len();
+    let x = Neighbourhood::of(x, o, n, s);
+    let (b, d, keep) = (&b[o..o + n], &d[o..o + n], &keep[i..i + n]);
+    for l in 0..n {
+        let new = d[l] * (b[l] + x.west[l] + x.east[l] + x.up[l] + x.down[l]);
+        out[l] = keep[l] * x.mid[l] + (1.0 - keep[l]) * new;
+    }
+}
+
+/// [`uniform`] on a coarse level's stencil of `east` and `north` couplings.
+#[inline(always)]
+fn coefficients(
+    out: &mut [f32],
+    x: &[f32],
+    (b, d, keep): (&[f32], &[f32], &[f32]),
+    (east, north): (&[f32], &[f32]),
+    (o, i): (usize, usize),
+    s: usize,
+) {
+    let n = out.len();
+    let x = Neighbourhood::of(x, o, n, s);
+    let (b, d, keep) = (&b[o..o + n], &d[o..o + n], &keep[i..i + n]);
+    let (e, no) = (
+        Neighbourhood::of(east, o, n, s),
+        Neighbourhood::of(north, o, n, s),
+    );
+    for l in 0..n {
+        let new = d[l]
+            * (b[l]
+                + e.mid[l] * x.east[l]
+                + e.west[l] * x.west[l]
+                + no.mid[l] * x.up[l]
+                + no.down[l] * x.down[l]);
+        out[l] = keep[l] * x.mid[l] + (1.0 - keep[l]) * new;
+    }
+}
+
+/// Writes the new values of the `n` cells of a row from padded index `k`: `new(out, x, i)`
+/// computes those of cells `i .. i + out.len()` of the row from the old values around them.
+///
+/// A short row is updated in place, [`LANES`] cells at a time, each chunk's new values stored
+/// only after the next chunk has read its old ones: every read sees the old row, as through a
+/// buffer (the same values, to the bit), without copying the buffer back, a call to `memcpy`
+/// per row and pass that was 7 % of a crowd's time on the windows' rows of 61 cells. The last
+/// chunk overlaps the one before it when `LANES` does not divide `n`; a cell both compute gets
+/// the same value from both. A long row, or one shorter than `LANES`, is computed into the
+/// buffer `t` and copied back (on a long row the copy's call costs nothing, and the loop over
+/// the whole row is faster than chunks: measured, 1024² room, 8 % slower in chunks).
+#[inline(always)]
+fn in_place(
+    x: &mut [f32],
+    (k, n): (usize, usize),
+    t: &mut [f32],
+    new: impl Fn(&mut [f32], &[f32], usize),
+) {
+    if !(LANES..LONG_ROW).contains(&n) {
+        new(&mut t[..n], x, 0);
+        x[k..k + n].copy_from_slice(&t[..n]);
+        return;
+    }
+    let next_at = |at: usize| {
+        if at + 2 * LANES <= n {
+            at + LANES
+        } else {
+            n - LANES
+        }
+    };
+    let mut pending = [0.0; LANES];
+    new(&mut pending, x, 0);
+    let mut at = 0;
+    while at + LANES < n {
+        let i = next_at(at);
+        let mut next = [0.0; LANES];
+        new(&mut next, x, i);
+        x[k + at..k + at + LANES].copy_from_slice(&pending);
+        (pending, at) = (next, i);
+    }
+    x[k + at..k + at + LANES].copy_from_slice(&pending);
+}
+
 /// The alternating patterns `keep[q][i] = 0` if `i % 2 == q`, else 1 (see [`Level::relax_row`]).
 pub type Keep = [Vec<f32>; 2];
 
@@ -22,9 +118,10 @@ impl Level {
     /// for `A x = b`.
     ///
     /// Cells of one colour depend only on cells of the other, so the row is computed whole
-    /// into `t` from the old values and the other colour's cells are kept (`keep`, an
-    /// alternating 0/1 pattern): twice the arithmetic of updating every other cell, but in
-    /// straight-line loops the compiler vectorizes, which is several times faster.
+    /// from the old values and the other colour's cells are kept (`keep`, an alternating 0/1
+    /// pattern): twice the arithmetic of updating every other cell, but in straight-line loops
+    /// the compiler vectorizes, which is several times faster. A short row is updated in place,
+    /// a long one through the buffer `t` (see [`in_place`]).
     #[inline(always)]
     pub fn relax_row(
         &self,
@@ -36,34 +133,24 @@ impl Level {
         keep: &Keep,
     ) {
         let (k, n) = self.row(j);
-        let t = &mut t[..n];
         let keep = &keep[(c + j) % 2][self.span(j)];
-        {
-            let x = Neighbourhood::of(x, k, n, self.stride);
-            let (b, d) = (&b[k..k + n], &self.inv_diag[k..k + n]);
-            match &self.stencil {
-                Stencil::Uniform => {
-                    for i in 0..n {
-                        let new = d[i] * (b[i] + x.west[i] + x.east[i] + x.up[i] + x.down[i]);
-                        t[i] = keep[i] * x.mid[i] + (1.0 - keep[i]) * new;
-                    }
-                }
-                Stencil::Coefficients { east, north, .. } => {
-                    let e = Neighbourhood::of(east, k, n, self.stride);
-                    let no = Neighbourhood::of(north, k, n, self.stride);
-                    for i in 0..n {
-                        let new = d[i]
-                            * (b[i]
-                                + e.mid[i] * x.east[i]
-                                + e.west[i] * x.west[i]
-                                + no.mid[i] * x.up[i]
-                                + no.down[i] * x.down[i]);
-                        t[i] = keep[i] * x.mid[i] + (1.0 - keep[i]) * new;
-                    }
-                }
-            }
+        let (s, d) = (self.stride, &self.inv_diag);
+        match &self.stencil {
+            Stencil::Uniform => in_place(
+                x,
+                (k, n),
+                t,
+                #[inline(always)]
+                |out, x, i| uniform(out, x, (b, d, keep), (k + i, i), s),
+            ),
+            Stencil::Coefficients { east, north, .. } => in_place(
+                x,
+                (k, n),
+                t,
+                #[inline(always)]
+                |out, x, i| coefficients(out, x, (b, d, keep), (east, north), (k + i, i), s),
+            ),
         }
-        x[k..k + n].copy_from_slice(t);
     }
 
     /// [`Level::relax_row`] when `x` is 0: `x = b / diagonal` on colour `c`, 0 elsewhere. It
