@@ -40,6 +40,13 @@
 //! only changes which direction CG takes (by 1e-7, as the f32 cycle already does) and never
 //! lets the residual drift from `b − A x`.
 //!
+//! A level at least 256 rows tall (the fine levels of a whole map's field) is swept by two
+//! threads: the rows below its middle and those above it at once, each pass stopping short of
+//! the middle by one row more than the last, then the rows between (`Part` in `smoother.rs`).
+//! Every cell gets the update one sweep gives it, and the sums are taken in row order, so the
+//! solution does not depend on the threads. The windows of local replanning are smaller: they
+//! are solved one per thread.
+//!
 //! The initial values of the unknown cells are the starting guess: a warm start from a previous
 //! solution makes a re-solve after a small change cheaper, though not by much, since CG still
 //! has to take the residual the change leaves (4–6e-3 of the first one for a wall moved by a
@@ -178,6 +185,38 @@ mod tests {
             .fold(0.0, f64::max);
         assert!(worst < 1e-9, "largest difference {worst:e}");
         stats
+    }
+
+    /// A grid tall enough for two threads to sweep its fine levels (see `cycle.rs`'s
+    /// `in_parts`), with walls across the rows where the two parts meet: the solution is the
+    /// one-thread solution to the bit.
+    #[test]
+    fn two_threads_give_the_one_thread_solution_to_the_bit() {
+        let grid = Grid::covering([3.4, 3.0], 0.01);
+        assert!(grid.ny >= 256, "{} rows", grid.ny);
+        let mut blocked = vec![false; grid.len()];
+        for (i, j) in (0..grid.nx).flat_map(|i| (0..grid.ny).map(move |j| (i, j))) {
+            // A wall across the middle rows with a gap, and a slanted one.
+            let across = (140..160).contains(&j) && !(40..60).contains(&i);
+            let slanted = i.abs_diff(j + 30) < 3 && j < 250;
+            blocked[grid.index(i, j)] = across || slanted;
+        }
+        let target = (300, 280);
+        let reachable = reachable_from(&grid, &blocked, target);
+        let mut unknown = reachable.clone();
+        unknown[grid.index(target.0, target.1)] = false;
+        let solve_with = |split: bool| {
+            cycle::set_split(split);
+            let mut w = vec![0.0; grid.len()];
+            w[grid.index(target.0, target.1)] = 1.0;
+            let stats = solve(&grid, &unknown, &mut w, 1e-12, 200);
+            cycle::set_split(true);
+            (stats, w.iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+        };
+        let (one, two) = (solve_with(false), solve_with(true));
+        assert!(one.0.relative_residual <= 1e-12, "{:?}", one.0);
+        assert_eq!(one.0, two.0);
+        assert!(one.1 == two.1, "the solutions differ");
     }
 
     /// A room with a divider and a pocket: multigrid agrees with the SOR reference.

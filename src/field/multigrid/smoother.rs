@@ -12,17 +12,18 @@ const LANES: usize = 8;
 const LONG_ROW: usize = 256;
 
 /// Gauss-Seidel's new values `out` of the cells from padded index `o` (row position `i`, for
-/// `keep`) on the finest level's uniform stencil, from `x`; `keep`'s cells keep their value.
+/// `keep`) on the finest level's uniform stencil, from `x` (which starts at padded index
+/// `origin`); `keep`'s cells keep their value.
 #[inline(always)]
 fn uniform(
     out: &mut [f32],
-    x: &[f32],
+    (x, origin): (&[f32], usize),
     (b, d, keep): (&[f32], &[f32], &[f32]),
     (o, i): (usize, usize),
     s: usize,
 ) {
     let n = out.len();
-    let x = Neighbourhood::of(x, o, n, s);
+    let x = Neighbourhood::of(x, o - origin, n, s);
     let (b, d, keep) = (&b[o..o + n], &d[o..o + n], &keep[i..i + n]);
     for l in 0..n {
         let new = d[l] * (b[l] + x.west[l] + x.east[l] + x.up[l] + x.down[l]);
@@ -34,14 +35,14 @@ fn uniform(
 #[inline(always)]
 fn coefficients(
     out: &mut [f32],
-    x: &[f32],
+    (x, origin): (&[f32], usize),
     (b, d, keep): (&[f32], &[f32], &[f32]),
     (east, north): (&[f32], &[f32]),
     (o, i): (usize, usize),
     s: usize,
 ) {
     let n = out.len();
-    let x = Neighbourhood::of(x, o, n, s);
+    let x = Neighbourhood::of(x, o - origin, n, s);
     let (b, d, keep) = (&b[o..o + n], &d[o..o + n], &keep[i..i + n]);
     let (e, no) = (
         Neighbourhood::of(east, o, n, s),
@@ -101,6 +102,82 @@ fn in_place(
     x[k + at..k + at + LANES].copy_from_slice(&pending);
 }
 
+/// The rows of a level that one wavefront covers ([`Level::sweep`]).
+///
+/// Two threads sweep a tall level together, exactly as one would: one the rows [`Part::Below`]
+/// its middle row `mid`, the other those [`Part::Above`] it, then one the rows
+/// [`Part::Between`] them. A pass `p` of Below stops `p + 1` rows short of `mid`, and one of
+/// Above starts `p + 1` rows past it, so that each reads only rows it alone writes or rows no
+/// one writes until both are done (`mid − 1` and `mid`), and no pass reads a row that a later
+/// pass has already updated (a pass updates one colour and reads the other, so a neighbour row
+/// may be one pass ahead, never two). Between then runs the passes over the triangle of rows
+/// they left. Each cell gets the very update it gets in one sweep of the whole level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Part {
+    /// Every row.
+    Whole,
+    /// The rows below `mid`.
+    Below {
+        /// The middle row (even).
+        mid: usize,
+    },
+    /// The rows above `mid`; its slice of `x` starts at row `mid`.
+    Above {
+        /// The middle row (even).
+        mid: usize,
+    },
+    /// The rows Below and Above leave.
+    Between {
+        /// The middle row (even).
+        mid: usize,
+    },
+}
+
+impl Part {
+    /// The rows pass `p` relaxes, of `ny`.
+    #[inline(always)]
+    pub fn relax(self, ny: usize, p: usize) -> std::ops::Range<usize> {
+        match self {
+            Part::Whole => 0..ny,
+            Part::Below { mid } => 0..mid.saturating_sub(p + 1),
+            Part::Above { mid } => (mid + p + 1).min(ny)..ny,
+            Part::Between { mid } => mid.saturating_sub(p + 1)..(mid + p + 1).min(ny),
+        }
+    }
+
+    /// The rows `before` runs for: those of the part's slice of `x`.
+    fn before(self, ny: usize) -> std::ops::Range<usize> {
+        match self {
+            Part::Whole => 0..ny,
+            Part::Below { mid } => 0..mid,
+            Part::Above { mid } => mid..ny,
+            Part::Between { .. } => 0..0,
+        }
+    }
+
+    /// The rows `after` runs for, after `passes` passes: the rows whose neighbours' last
+    /// passes the part does or follows. Above's start even, so that the two rows a coarse cell
+    /// restricts from are done in order (the even one sets, the odd one adds).
+    pub fn after(self, ny: usize, passes: usize) -> std::ops::Range<usize> {
+        let below = |mid: usize| mid.saturating_sub(passes + 1);
+        let above = |mid: usize| (mid + passes + 1).next_multiple_of(2).min(ny);
+        match self {
+            Part::Whole => 0..ny,
+            Part::Below { mid } => 0..below(mid),
+            Part::Above { mid } => above(mid)..ny,
+            Part::Between { mid } => below(mid)..above(mid),
+        }
+    }
+
+    /// The padded index where the part's slice of a level's vector starts.
+    pub fn origin(self, level: &Level) -> usize {
+        match self {
+            Part::Above { mid } => level.pad(0, mid) - 1,
+            _ => 0,
+        }
+    }
+}
+
 /// The alternating patterns `keep[q][i] = 0` if `i % 2 == q`, else 1 (see [`Level::relax_row`]).
 pub type Keep = [Vec<f32>; 2];
 
@@ -127,7 +204,7 @@ impl Level {
         &self,
         c: usize,
         j: usize,
-        x: &mut [f32],
+        (x, origin): (&mut [f32], usize),
         b: &[f32],
         t: &mut [f32],
         keep: &Keep,
@@ -138,17 +215,19 @@ impl Level {
         match &self.stencil {
             Stencil::Uniform => in_place(
                 x,
-                (k, n),
+                (k - origin, n),
                 t,
                 #[inline(always)]
-                |out, x, i| uniform(out, x, (b, d, keep), (k + i, i), s),
+                |out, x, i| uniform(out, (x, origin), (b, d, keep), (k + i, i), s),
             ),
             Stencil::Coefficients { east, north, .. } => in_place(
                 x,
-                (k, n),
+                (k - origin, n),
                 t,
                 #[inline(always)]
-                |out, x, i| coefficients(out, x, (b, d, keep), (east, north), (k + i, i), s),
+                |out, x, i| {
+                    coefficients(out, (x, origin), (b, d, keep), (east, north), (k + i, i), s)
+                },
             ),
         }
     }
@@ -156,61 +235,79 @@ impl Level {
     /// [`Level::relax_row`] when `x` is 0: `x = b / diagonal` on colour `c`, 0 elsewhere. It
     /// reads nothing of `x`, so a cycle that starts from 0 need not clear it first.
     #[inline(always)]
-    pub fn relax_row_from_zero(&self, c: usize, j: usize, x: &mut [f32], b: &[f32], keep: &Keep) {
+    pub fn relax_row_from_zero(
+        &self,
+        c: usize,
+        j: usize,
+        (x, origin): (&mut [f32], usize),
+        b: &[f32],
+        keep: &Keep,
+    ) {
         let (k, n) = self.row(j);
         let keep = &keep[(c + j) % 2][self.span(j)];
-        let (x, b, d) = (&mut x[k..k + n], &b[k..k + n], &self.inv_diag[k..k + n]);
+        let x = &mut x[k - origin..k - origin + n];
+        let (b, d) = (&b[k..k + n], &self.inv_diag[k..k + n]);
         for i in 0..n {
             x[i] = (1.0 - keep[i]) * d[i] * b[i];
         }
     }
 
-    /// The Gauss-Seidel passes `colours` (one colour each, in order) over the whole level, as a
-    /// wavefront: at step `s`, pass `p` updates row `s − p`. That is exactly the passes one
+    /// The Gauss-Seidel passes `colours` (one colour each, in order) over the rows of `part`,
+    /// as a wavefront: at step `s`, pass `p` updates row `s − p`. That is exactly the passes one
     /// after another (a row's update reads only rows beside it, which every earlier pass has
     /// already updated and no later pass has touched yet), but the rows in flight stay in
     /// cache, so the level is read from memory once instead of once per pass. `before(r)` runs
     /// before any pass reads row `r`; `after(r)` once every pass is done with rows `r − 1`,
-    /// `r` and `r + 1`. With `zero_start`, the first pass takes `x` as 0, whatever it holds.
+    /// `r` and `r + 1` (for the rows `part` gives them). With `zero_start`, the first pass
+    /// takes `x` as 0, whatever it holds. `x` is the part's slice of the level's vector, from
+    /// padded index [`Part::origin`].
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub fn sweep(
         &self,
         colours: &[usize],
         zero_start: bool,
+        part: Part,
         (x, b): (&mut [f32], &[f32]),
         (t, keep): (&mut [f32], &Keep),
         mut before: impl FnMut(usize, &mut [f32]),
         mut after: impl FnMut(usize, &[f32]),
     ) {
-        let passes = colours.len();
-        if self.ny > 0 {
+        let (passes, ny) = (colours.len(), self.ny);
+        let origin = part.origin(self);
+        let (early, late) = (part.before(ny), part.after(ny, passes));
+        if early.contains(&0) {
             before(0, x);
         }
-        for step in 0..self.ny + passes + 1 {
-            if step + 1 < self.ny {
+        for step in 0..ny + passes + 1 {
+            if early.contains(&(step + 1)) {
                 before(step + 1, x);
             }
             for (p, &c) in colours.iter().enumerate() {
-                if let Some(j) = step.checked_sub(p).filter(|&j| j < self.ny) {
+                if let Some(j) = step
+                    .checked_sub(p)
+                    .filter(|j| part.relax(ny, p).contains(j))
+                {
                     if p == 0 && zero_start {
-                        self.relax_row_from_zero(c, j, x, b, keep);
+                        self.relax_row_from_zero(c, j, (x, origin), b, keep);
                     } else {
-                        self.relax_row(c, j, x, b, t, keep);
+                        self.relax_row(c, j, (x, origin), b, t, keep);
                     }
                 }
             }
-            if let Some(j) = step.checked_sub(passes).filter(|&j| j < self.ny) {
+            if let Some(j) = step.checked_sub(passes).filter(|j| late.contains(j)) {
                 after(j, x);
             }
         }
     }
 
-    /// The residual `b − A x` of row `j` into `row` (0 on inactive cells).
+    /// The residual `b − A x` of row `j` into `row` (0 on inactive cells); `x` starts at
+    /// padded index `origin`.
     #[inline(always)]
-    pub fn residual_row(&self, j: usize, x: &[f32], b: &[f32], row: &mut [f32]) {
+    pub fn residual_row(&self, j: usize, (x, origin): (&[f32], usize), b: &[f32], row: &mut [f32]) {
         let (k, n) = self.row(j);
         let row = &mut row[..n];
-        let x = Neighbourhood::of(x, k, n, self.stride);
+        let x = Neighbourhood::of(x, k - origin, n, self.stride);
         let b = &b[k..k + n];
         match &self.stencil {
             Stencil::Uniform => {
