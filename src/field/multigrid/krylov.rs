@@ -2,8 +2,10 @@
 //! initial residual, the iteration with one W-cycle per step as the preconditioner, and the
 //! copy of the solution back onto the grid.
 
+use std::ops::Range;
+
 use super::Stats;
-use super::cycle::Hierarchy;
+use super::cycle::{Hierarchy, split_at};
 use super::kernels::{Neighbourhood, dot, for_cycle, wide};
 use super::level::Level;
 use crate::field::Grid;
@@ -15,8 +17,11 @@ pub struct Krylov {
     x: Vec<f64>,
     r: Vec<f64>,
     q: Vec<f32>,
-    /// One row of `A q`.
-    row: Vec<f64>,
+    /// One row of `A q` per thread (see [`split_at`]).
+    rows: [Vec<f64>; 2],
+    /// Each row's term of a sum over the rows, summed in row order (whichever thread computed
+    /// it).
+    dots: Vec<f64>,
     /// `‖b‖`, the norm the residual is measured against.
     norm_b: f64,
     /// `r · r`.
@@ -82,7 +87,8 @@ impl Krylov {
             x,
             r: fixed,
             q: vec![0.0; n],
-            row: vec![0.0; nx],
+            rows: [vec![0.0; nx], vec![0.0; nx]],
+            dots: vec![0.0; ny],
             norm_b: bb.sqrt(),
             rr,
         }
@@ -164,64 +170,144 @@ impl Krylov {
 
     /// The new direction `q = z + γ q` and its curvature `q · A q`: one pass, `A q` trailing a
     /// row behind the rows it reads. (`q` is 0 on inactive cells, so they add nothing to the
-    /// sum whatever the stencil gives there.)
+    /// sum whatever the stencil gives there.) On a tall level two threads take the rows below
+    /// and above the middle, each leaving `A q` on the row next to the other's; those two rows
+    /// come last.
     fn direct(&mut self, level: &Level, z: &[f32], gamma: f32) -> f64 {
-        let Self { q, row, .. } = self;
-        wide(
-            #[inline(always)]
-            || {
-                let mut qaq = 0.0;
-                for j in 0..level.ny + 1 {
-                    if j < level.ny {
-                        let (k, n) = level.row(j);
-                        for (q, z) in q[k..k + n].iter_mut().zip(&z[k..k + n]) {
-                            *q = z + gamma * *q;
+        let Self { q, rows, dots, .. } = self;
+        let dots = &mut dots[..level.ny];
+        // `q = z + γ q` on `rows` and `q · A q` of the rows `applied` among them, with `q`
+        // starting at padded index `origin` and `dots` at row `first`.
+        let part = |rows: Range<usize>,
+                    applied: Range<usize>,
+                    (q, origin): (&mut [f32], usize),
+                    (row, dots, first): (&mut [f64], &mut [f64], usize)| {
+            wide(
+                #[inline(always)]
+                || {
+                    for j in rows.start..rows.end + 1 {
+                        if j < rows.end {
+                            let (k, n) = level.row(j);
+                            let q = &mut q[k - origin..k - origin + n];
+                            for (q, z) in q.iter_mut().zip(&z[k..k + n]) {
+                                *q = z + gamma * *q;
+                            }
+                        }
+                        if let Some(j) = j.checked_sub(1).filter(|j| applied.contains(j)) {
+                            dots[j - first] = curvature(level, (q, origin), j, row);
                         }
                     }
-                    if j > 0 {
-                        apply_row(level, q, j - 1, row);
-                        let (k, n) = level.row(j - 1);
-                        qaq += dot(&q[k..k + n], &row[..n]);
-                    }
+                },
+            )
+        };
+        let [row, second] = rows;
+        match split_at(level) {
+            None => part(0..level.ny, 0..level.ny, (q, 0), (row, dots, 0)),
+            Some(mid) => {
+                let at = level.pad(0, mid) - 1;
+                let ((q_below, q_above), (d_below, d_above)) =
+                    (q.split_at_mut(at), dots.split_at_mut(mid));
+                rayon::join(
+                    || part(0..mid, 0..mid - 1, (q_below, 0), (row, d_below, 0)),
+                    || {
+                        part(
+                            mid..level.ny,
+                            mid + 1..level.ny,
+                            (q_above, at),
+                            (second, d_above, mid),
+                        )
+                    },
+                );
+                for j in mid - 1..mid + 1 {
+                    dots[j] = wide(
+                        #[inline(always)]
+                        || curvature(level, (q, 0), j, row),
+                    );
                 }
-                qaq
-            },
-        )
+            }
+        }
+        dots.iter().fold(0.0, |sum, d| sum + d)
     }
 
     /// The step `x += c q`, `r −= c A q` (on the active cells), the new `r · r`, and
-    /// `out = r · scale` in f32 (the next cycle's right-hand side): one pass.
+    /// `out = r · scale` in f32 (the next cycle's right-hand side): one pass (on a tall level,
+    /// two threads each take half the rows).
     fn step(&mut self, level: &Level, c: f64, scale: f64, out: &mut [f32]) -> f64 {
-        let Self { x, r, q, row, .. } = self;
-        wide(
-            #[inline(always)]
-            || {
-                let mut rr = 0.0;
-                for j in 0..level.ny {
-                    apply_row(level, q, j, row);
-                    let (k, n) = level.row(j);
-                    let (x, r, q) = (&mut x[k..k + n], &mut r[k..k + n], &q[k..k + n]);
-                    let (d, out) = (&level.inv_diag[k..k + n], &mut out[k..k + n]);
-                    for i in 0..n {
-                        x[i] += c * f64::from(q[i]);
-                        r[i] -= if d[i] != 0.0 { c * row[i] } else { 0.0 };
-                        out[i] = for_cycle(r[i], scale);
+        let Self {
+            x,
+            r,
+            q,
+            rows,
+            dots,
+            ..
+        } = self;
+        let (q, dots) = (&*q, &mut dots[..level.ny]);
+        // The step on `rows`, with `x`, `r` and `out` starting at padded index `origin` and
+        // `dots` at the first row.
+        let part = |rows: Range<usize>,
+                    origin: usize,
+                    (x, r, out): (&mut [f64], &mut [f64], &mut [f32]),
+                    (row, dots): (&mut [f64], &mut [f64])| {
+            wide(
+                #[inline(always)]
+                || {
+                    for j in rows.clone() {
+                        apply_row(level, (q, 0), j, row);
+                        let (k, n) = level.row(j);
+                        let d = &level.inv_diag[k..k + n];
+                        let (k, q) = (k - origin, &q[k..k + n]);
+                        let (x, r, out) = (&mut x[k..k + n], &mut r[k..k + n], &mut out[k..k + n]);
+                        for i in 0..n {
+                            x[i] += c * f64::from(q[i]);
+                            r[i] -= if d[i] != 0.0 { c * row[i] } else { 0.0 };
+                            out[i] = for_cycle(r[i], scale);
+                        }
+                        dots[j - rows.start] = dot(r, r);
                     }
-                    rr += dot(r, r);
-                }
-                rr
-            },
-        )
+                },
+            )
+        };
+        let [row, second] = rows;
+        match split_at(level) {
+            None => part(0..level.ny, 0, (x, r, out), (row, dots)),
+            Some(mid) => {
+                let at = level.pad(0, mid) - 1;
+                let (x_below, x_above) = x.split_at_mut(at);
+                let (r_below, r_above) = r.split_at_mut(at);
+                let (out_below, out_above) = out.split_at_mut(at);
+                let (d_below, d_above) = dots.split_at_mut(mid);
+                rayon::join(
+                    || part(0..mid, 0, (x_below, r_below, out_below), (row, d_below)),
+                    || {
+                        part(
+                            mid..level.ny,
+                            at,
+                            (x_above, r_above, out_above),
+                            (second, d_above),
+                        )
+                    },
+                );
+            }
+        }
+        dots.iter().fold(0.0, |sum, d| sum + d)
     }
+}
+
+/// `q · A q` on row `j` (`q` starting at padded index `origin`), with `row` to hold `A q`.
+#[inline(always)]
+fn curvature(level: &Level, (q, origin): (&[f32], usize), j: usize, row: &mut [f64]) -> f64 {
+    apply_row(level, (q, origin), j, row);
+    let (k, n) = level.row(j);
+    dot(&q[k - origin..k - origin + n], &row[..n])
 }
 
 /// `A q` on row `j` of the fine level, in f64, into `out`: the 5-point stencil on every cell,
 /// so it is `A q` on the active cells only (`q` is 0 on the others). `q` holds f32 values, so
-/// the sums are exact in f64.
+/// the sums are exact in f64. `q` starts at padded index `origin`.
 #[inline(always)]
-fn apply_row(level: &Level, q: &[f32], j: usize, out: &mut [f64]) {
+fn apply_row(level: &Level, (q, origin): (&[f32], usize), j: usize, out: &mut [f64]) {
     let (k, n) = level.row(j);
-    let q = Neighbourhood::of(q, k, n, level.stride);
+    let q = Neighbourhood::of(q, k - origin, n, level.stride);
     let out = &mut out[..n];
     for i in 0..n {
         out[i] = 4.0 * f64::from(q.mid[i])
