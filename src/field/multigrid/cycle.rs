@@ -160,7 +160,7 @@ impl Hierarchy {
         // Above's rows restrict onto coarse rows from half its first `after` row on.
         let split = |part: Part| {
             let first = part.after(level.ny, colours.len()).start;
-            coarse.pad(0, first / 2) - 1
+            coarse.row_start(first / 2)
         };
         let sweep = |part: Part,
                      x: &mut [f32],

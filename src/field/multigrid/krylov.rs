@@ -204,7 +204,7 @@ impl Krylov {
         match split_at(level) {
             None => part(0..level.ny, 0..level.ny, (q, 0), (row, dots, 0)),
             Some(mid) => {
-                let at = level.pad(0, mid) - 1;
+                let at = level.row_start(mid);
                 let ((q_below, q_above), (d_below, d_above)) =
                     (q.split_at_mut(at), dots.split_at_mut(mid));
                 rayon::join(
@@ -271,7 +271,7 @@ impl Krylov {
         match split_at(level) {
             None => part(0..level.ny, 0, (x, r, out), (row, dots)),
             Some(mid) => {
-                let at = level.pad(0, mid) - 1;
+                let at = level.row_start(mid);
                 let (x_below, x_above) = x.split_at_mut(at);
                 let (r_below, r_above) = r.split_at_mut(at);
                 let (out_below, out_above) = out.split_at_mut(at);

@@ -76,6 +76,13 @@ impl Level {
         (j + 1) * self.stride + i + 1
     }
 
+    /// The padded index where row `j` begins (its cell in the ring, west of `(0, j)`): split
+    /// there, a vector's rows below `j` and its rows from `j` on are two disjoint slices.
+    #[inline(always)]
+    pub fn row_start(&self, j: usize) -> usize {
+        (j + 1) * self.stride
+    }
+
     /// The columns of row `j` that a pass goes over (see [`Level::spans`]).
     #[inline(always)]
     pub fn span(&self, j: usize) -> std::ops::Range<usize> {

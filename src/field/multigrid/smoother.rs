@@ -172,7 +172,7 @@ impl Part {
     /// The padded index where the part's slice of a level's vector starts.
     pub fn origin(self, level: &Level) -> usize {
         match self {
-            Part::Above { mid } => level.pad(0, mid) - 1,
+            Part::Above { mid } => level.row_start(mid),
             _ => 0,
         }
     }
