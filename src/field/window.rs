@@ -23,7 +23,7 @@ use std::time::{Duration, Instant};
 
 use super::grid::Grid;
 use super::mask::{Disc, disc_cells, obstacle_discs};
-use super::multigrid;
+use super::multigrid::{self, Cycle};
 use super::nested::{DEPTH_STEP, MAX_ITERATIONS, Stop, deep_cells, solve_levels};
 use super::sample::NEAR;
 use super::scaled::{ScaledW, exponent_of, ldexp};
@@ -45,8 +45,13 @@ use crate::world::Agent;
 ///   are solved (see `read_by_rings`).
 /// - Both are solved to a relative residual of 1e-9 (or the field's tolerance if looser): their
 ///   difference from a full re-solve, degrees of guidance near the others, is far above what a
-///   tighter solve changes, and it takes about a third fewer iterations than 1e-12. Cells below
-///   what the solve resolves go to the nested levels, as in a full solve.
+///   tighter solve changes, and it takes about a third fewer iterations than 1e-12 (see
+///   `WINDOW_TOLERANCE`). Cells below what the solve resolves go to the nested levels, as in
+///   a full solve.
+/// - A window with a coarse window starts its solve from 0, not from the field of the walls:
+///   the coarse window's ring can be orders of magnitude below that field where the others
+///   close the way, and starting from it left a residual up to 1e9 times the right-hand side's
+///   (see `zero_start`).
 /// - A replan that sets the very problem the last one solved (an agent parked among parked
 ///   neighbours, while its coarse window is reused) is served that solution, which is the
 ///   solve's to the bit (see `Solved`).
@@ -167,13 +172,32 @@ pub const COARSE: usize = 4;
 /// they were then), while the agent stays within a quarter of its reach of where it was solved:
 /// the agents it shows are far, and move little between replans, so it is re-solved every fifth
 /// replan (twice a second at 10 Hz).
+///
+/// Not more: 9 saved about a tenth of 32 robots' wall time on the 1.8 m circle, but the last
+/// robot settled 26.2 → 29.3 s later on average over ten seeds (a staler ring steers worse).
 pub const COARSE_REUSE: u32 = 4;
 
 /// The relative residual a window is solved to, unless the field's own tolerance is looser:
 /// the window's difference from a full re-solve (degrees of guidance near the others) is far
 /// above what a tighter solve would change, and 1e-9 takes about a third fewer iterations than
 /// the default 1e-12. Cells below what it resolves go to the nested levels as in a full solve.
+///
+/// Not looser: 1e-7 saved about a tenth of a crowd's time, but it leaves one digit at the depth
+/// the nested levels take over from ([`DEPTH_STEP`], 1e-6), and the guidance there steers
+/// worse. With 1e-7 and a coarse window reused 9 times, 16 robots on the 2.5 m circle settled
+/// 17.8 → 18.9 s on average over ten seeds, 32 robots 30.5 → 32.2 s.
 pub const WINDOW_TOLERANCE: f64 = 1e-9;
+
+/// A window at most this many cells along each side is solved with V-cycles, a larger one
+/// (the whole grid's coarse window in a large room) with W-cycles. On a small grid the W-cycle's
+/// extra visits cost more than the iterations they save: its coarse levels are a few rows of a
+/// few cells each, where a row's overhead outweighs its arithmetic. Measured: 64 robots on the
+/// 1.8 m circle (first 12 s; fine windows 62² cells, coarse ones up to 98²) in 10.7–11.0 s
+/// against 11.4–11.6 s with W-cycles; the paper's room at 101² (to 1e-12) in 4.9 ms with
+/// V-cycles (20 iterations) against 5.2 ms (13), but at 201² in 17.2 ms against 11.3. Full
+/// solves keep the W-cycle: the nested levels' parts, small too, took 4 % more iterations (and
+/// up to 3 % more time) with V-cycles on the rooms map's longest field.
+pub const V_CYCLE_SIDE: usize = 128;
 
 /// How far the coarse window that gives a window's edge extends.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -349,6 +373,9 @@ impl Window {
         if !whole && !leads_on(&problem, (grid, reachable, w), (&ir, &jr), position) {
             return Err(unreachable());
         }
+        if coarse.is_some() {
+            zero_start(&mut problem);
+        }
         let last = previous.map(|p| &p.solved);
         let (solved, iterations) =
             Solved::solve(problem, agent, position, (tolerance, Stop::Never), last)?;
@@ -381,6 +408,24 @@ impl Window {
         let fy = (p[1] - g.origin[1]) / g.cell - 0.5;
         let [x, y] = self.interior;
         fx >= x[0] && fx < x[1] && fy >= y[0] && fy < y[1]
+    }
+}
+
+/// Starts `problem`'s solve from 0 on its unknown cells: for a window whose ring comes from a
+/// coarse window. The field of the walls, the starting guess otherwise, is far above that ring
+/// where the others close the way ahead (the coarse window shows the crowd; the walls do not),
+/// and CG then spent its first iterations taking that excess down. Measured on 64 robots on the
+/// 1.8 m circle (first 12 s; windows to 1e-7 for the counts): the first residual was a median
+/// of about 1e4 and up to 1e9 times the right-hand side, and a window took 11.2 iterations. From
+/// 0 the first residual is the right-hand side itself, and a window takes about 7 (its coarse
+/// window's counted in). The coarse window's own values as the guess did no better (6.9
+/// iterations), and sampling them cost 12 % of the run. At 1e-9 the run's first 12 s took
+/// 11.9 s against 12.8 s.
+fn zero_start(problem: &mut Problem) {
+    for k in 0..problem.grid.len() {
+        if !problem.known[k] {
+            (problem.values.mantissa[k], problem.values.exponent[k]) = (0.0, 0);
+        }
     }
 }
 
@@ -457,7 +502,8 @@ fn coarse_problem(
         problem.free[k] = reachable[g] && !under_disc[k];
         let ring = i == 0 || j == 0 || i + 1 == coarse.nx || j + 1 == coarse.ny;
         let target = target_cell == Some((i, j))
-            || (centre[0] - agent.target[0]).hypot(centre[1] - agent.target[1]) <= target_radius;
+            || square(centre[0] - agent.target[0], centre[1] - agent.target[1])
+                <= target_radius * target_radius;
         problem.known[k] = !problem.free[k] || ring || target;
         if target && problem.free[k] {
             (problem.values.mantissa[k], problem.values.exponent[k]) = (1.0, 0);
@@ -531,7 +577,19 @@ fn solve_problem(
             }
         })
         .collect();
-    let stats = multigrid::solve(&local, &unknown, &mut values, tolerance, MAX_ITERATIONS);
+    let cycle = if local.nx.max(local.ny) <= V_CYCLE_SIDE {
+        Cycle::V
+    } else {
+        Cycle::W
+    };
+    let stats = multigrid::solve_with(
+        cycle,
+        &local,
+        &unknown,
+        &mut values,
+        tolerance,
+        MAX_ITERATIONS,
+    );
     if stats.relative_residual.is_nan() || stats.relative_residual > tolerance {
         return Err(FieldError::Solver {
             agent: agent.name.clone(),
@@ -572,13 +630,18 @@ fn stamp(grid: &Grid, discs: &[Disc], radius: f64) -> Vec<bool> {
         for j in jr {
             for i in ir.clone() {
                 let [x, y] = grid.center(i, j);
-                if (x - d.center[0]).hypot(y - d.center[1]) < r {
+                if square(x - d.center[0], y - d.center[1]) < r * r {
                     under[grid.index(i, j)] = true;
                 }
             }
         }
     }
     under
+}
+
+/// `x² + y²`: the cell loops compare squared distances (`hypot` was 4 % of a crowd's time).
+fn square(x: f64, y: f64) -> f64 {
+    x * x + y * y
 }
 
 /// Whether the part of the window the agent is in leads on: it holds a cell of the target disc,

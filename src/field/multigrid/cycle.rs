@@ -1,6 +1,7 @@
 //! The preconditioner: the hierarchy of levels ([`Hierarchy`]) and one W-cycle over it —
 //! pre-smoothing and restriction, two visits of the next coarser level, prolongation and
-//! post-smoothing — with an exact solve on the coarsest level ([`Coarsest`]).
+//! post-smoothing — with an exact solve on the coarsest level ([`Coarsest`]) — or, when the
+//! caller asks for it ([`Cycle::V`]), one V-cycle.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -11,8 +12,25 @@ use super::smoother::{Keep, Part, keep_patterns};
 
 /// Smoothing sweeps before and after each coarse correction.
 const SWEEPS: usize = 2;
-/// Coarse-level visits per cycle: 1 is a V-cycle, 2 a W-cycle.
-const VISITS: usize = 2;
+/// The cycle that preconditions each CG iteration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cycle {
+    /// Each coarse level visited once per visit of the level above.
+    V,
+    /// Each coarse level visited twice: the iteration count stays flat with the grid's size
+    /// (see the module `multigrid`), for about 1.5× a V-cycle's work.
+    W,
+}
+
+impl Cycle {
+    /// Coarse-level visits per visit of the level above.
+    fn visits(self) -> usize {
+        match self {
+            Cycle::V => 1,
+            Cycle::W => 2,
+        }
+    }
+}
 /// A level with at most this many unknowns is solved exactly.
 const COARSEST: usize = 64;
 /// A level at least this many rows tall is swept by two threads (see [`Part`]): the fine levels
@@ -92,11 +110,13 @@ pub struct Hierarchy {
     keep: Keep,
     /// The coarsest solve's scratch.
     scratch: Vec<f64>,
+    /// Coarse-level visits per visit of the level above (see [`Cycle`]).
+    visits: usize,
 }
 
 impl Hierarchy {
-    /// The hierarchy of the `nx × ny` grid's `unknown` cells.
-    pub fn new(nx: usize, ny: usize, unknown: &[bool]) -> Self {
+    /// The hierarchy of the `nx × ny` grid's `unknown` cells, preconditioning with `cycle`.
+    pub fn new(nx: usize, ny: usize, unknown: &[bool], cycle: Cycle) -> Self {
         let mut levels = vec![Level::finest(nx, ny, unknown)];
         loop {
             let last = levels.last().expect("one level");
@@ -122,6 +142,7 @@ impl Hierarchy {
             coarsest,
             work,
             scratch: Vec::new(),
+            visits: cycle.visits(),
         }
     }
 
@@ -140,7 +161,7 @@ impl Hierarchy {
             return if l == 0 { dot(x, b) } else { 0.0 };
         }
         self.smooth_and_restrict(l, zero_start);
-        for visit in 0..VISITS {
+        for visit in 0..self.visits {
             self.cycle(l + 1, visit == 0);
         }
         self.prolong_and_smooth(l)

@@ -5,15 +5,16 @@
 //! The 5-point system `4 u_k − Σ u_neighbour = 0` is symmetric positive definite, and conjugate
 //! gradients solve it in f64.
 //!
-//! The preconditioner is one W-cycle. Its hierarchy aggregates 2 × 2 cells with
-//! piecewise-constant prolongation, restriction by its transpose and Galerkin coarse operators
-//! `R A P`. These stay 5-point stencils and follow the mask exactly, however thin its walls are:
-//! two regions that a wall separates are never coupled on a coarse level. Each level smooths with
-//! red-black Gauss-Seidel (red then black before the coarse correction, black then red after it)
-//! and the coarsest level is solved exactly (Cholesky), so the cycle is a symmetric operator, as
-//! CG needs. A V-cycle of this hierarchy loses a little on every level (26 CG iterations at
-//! 1024², growing with the grid); visiting each coarse level twice (the W-cycle) keeps the count
-//! flat (11 at 256² and at 2048²) for about 1.5× the work per cycle.
+//! The preconditioner is one W-cycle (or one V-cycle, see below). Its hierarchy aggregates 2 × 2
+//! cells with piecewise-constant prolongation, restriction by its transpose and Galerkin coarse
+//! operators `R A P`. These stay 5-point stencils and follow the mask exactly, however thin its
+//! walls are: two regions that a wall separates are never coupled on a coarse level. Each level
+//! smooths with red-black Gauss-Seidel (red then black before the coarse correction, black then red
+//! after it) and the coarsest level is solved exactly (Cholesky), so the cycle is a symmetric
+//! operator, as CG needs. A V-cycle of this hierarchy loses a little on every level (26 CG
+//! iterations at 1024², growing with the grid); visiting each coarse level twice (the W-cycle)
+//! keeps the count flat (11 at 256² and at 2048²) for about 1.5× the work per cycle. A caller may
+//! ask for the V-cycle ([`solve_with`]): the windows of local replanning do (see `window.rs`).
 //!
 //! The cycle runs in f32. It only has to approximate `A⁻¹`: its rounding (1e-7) is far below
 //! its approximation error, CG in f64 corrects both, and f32 halves the memory traffic, which is
@@ -63,6 +64,7 @@ mod krylov;
 mod level;
 mod smoother;
 
+pub use cycle::Cycle;
 pub use kernels::set_portable;
 
 use super::grid::Grid;
@@ -89,21 +91,33 @@ pub fn solve(
     tolerance: f64,
     max_iterations: usize,
 ) -> Stats {
-    match Crop::of(grid, unknown) {
-        Some(crop) => crop.solve(grid, unknown, values, tolerance, max_iterations),
-        None => solve_all(grid, unknown, values, tolerance, max_iterations),
-    }
+    solve_with(Cycle::W, grid, unknown, values, tolerance, max_iterations)
 }
 
-/// [`solve`] over the whole of `grid`.
-fn solve_all(
+/// [`solve`] with `cycle` as the preconditioner ([`solve`] takes [`Cycle::W`]).
+pub fn solve_with(
+    cycle: Cycle,
     grid: &Grid,
     unknown: &[bool],
     values: &mut [f64],
     tolerance: f64,
     max_iterations: usize,
 ) -> Stats {
-    let mut hierarchy = Hierarchy::new(grid.nx, grid.ny, unknown);
+    let problem = (grid, unknown, values);
+    match Crop::of(grid, unknown) {
+        Some(crop) => crop.solve(cycle, problem, tolerance, max_iterations),
+        None => solve_all(cycle, problem, tolerance, max_iterations),
+    }
+}
+
+/// [`solve_with`] over the whole of `grid`.
+fn solve_all(
+    cycle: Cycle,
+    (grid, unknown, values): (&Grid, &[bool], &mut [f64]),
+    tolerance: f64,
+    max_iterations: usize,
+) -> Stats {
+    let mut hierarchy = Hierarchy::new(grid.nx, grid.ny, unknown, cycle);
     let fine = &hierarchy.levels[0];
     let mut cg = Krylov::start(fine, grid, unknown, values);
     let stats = cg.iterate(&mut hierarchy, tolerance, max_iterations);
@@ -132,12 +146,11 @@ impl Crop {
         (2 * i.len() * j.len() <= grid.len()).then_some(Self { i, j })
     }
 
-    /// [`solve`] on the box: its cells copied out, solved, and the unknown ones copied back.
+    /// [`solve_with`] on the box: its cells copied out, solved, and the unknown ones copied back.
     fn solve(
         &self,
-        grid: &Grid,
-        unknown: &[bool],
-        values: &mut [f64],
+        cycle: Cycle,
+        (grid, unknown, values): (&Grid, &[bool], &mut [f64]),
         tolerance: f64,
         max_iterations: usize,
     ) -> Stats {
@@ -145,13 +158,8 @@ impl Crop {
         let global = |k: usize| grid.index(self.i.start + k % sub.nx, self.j.start + k / sub.nx);
         let sub_unknown: Vec<bool> = (0..sub.len()).map(|k| unknown[global(k)]).collect();
         let mut sub_values: Vec<f64> = (0..sub.len()).map(|k| values[global(k)]).collect();
-        let stats = solve_all(
-            &sub,
-            &sub_unknown,
-            &mut sub_values,
-            tolerance,
-            max_iterations,
-        );
+        let sub_problem = (&sub, &sub_unknown[..], &mut sub_values[..]);
+        let stats = solve_all(cycle, sub_problem, tolerance, max_iterations);
         for (k, v) in sub_values.into_iter().enumerate() {
             if sub_unknown[k] {
                 values[global(k)] = v;
@@ -288,6 +296,26 @@ mod tests {
         );
     }
 
+    /// The V-cycle, which the windows of local replanning take, solves the same system to the
+    /// tolerance (the solution agrees with the W-cycle's to it), in more iterations than the
+    /// W-cycle but fewer than twice as many on a window's size of grid.
+    #[test]
+    fn the_v_cycle_solves_a_window_sized_grid() {
+        let (grid, unknown, w) = divided_room(62);
+        let (mut by_v, mut by_w) = (w.clone(), w);
+        let v = solve_with(Cycle::V, &grid, &unknown, &mut by_v, 1e-10, 100);
+        let w = solve_with(Cycle::W, &grid, &unknown, &mut by_w, 1e-10, 100);
+        assert!(v.relative_residual <= 1e-10 && w.relative_residual <= 1e-10);
+        assert!(
+            v.iterations > w.iterations && v.iterations < 2 * w.iterations,
+            "{v:?} {w:?}"
+        );
+        let worst = (by_v.iter().zip(&by_w))
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "largest difference {worst:e}");
+    }
+
     /// A few unknowns among many Dirichlet cells are solved on their box (see `Crop`): the
     /// same solution as over the whole grid, to the tolerance, and no cell outside the box is
     /// written. The unknowns: a ring of cells around a square held at 1, at the grid's corner
@@ -315,7 +343,7 @@ mod tests {
             );
             let mut whole = w.clone();
             let on_box = solve(&grid, &unknown, &mut w, 1e-12, 100);
-            let all = solve_all(&grid, &unknown, &mut whole, 1e-12, 100);
+            let all = solve_all(Cycle::W, (&grid, &unknown, &mut whole), 1e-12, 100);
             assert!(on_box.relative_residual <= 1e-12 && all.relative_residual <= 1e-12);
             let worst = (w.iter().zip(&whole))
                 .map(|(a, b)| (a - b).abs())
