@@ -48,10 +48,7 @@ use crate::world::Agent;
 ///   tighter solve changes, and it takes about a third fewer iterations than 1e-12 (see
 ///   `WINDOW_TOLERANCE`). Cells below what the solve resolves go to the nested levels, as in
 ///   a full solve.
-/// - A window with a coarse window starts its solve from 0, not from the field of the walls:
-///   the coarse window's ring can be orders of magnitude below that field where the others
-///   close the way, and starting from it left a residual up to 1e9 times the right-hand side's
-///   (see `zero_start`).
+/// - The unknown cells start from the field of the walls (see `Problem`).
 /// - A replan that sets the very problem the last one solved (an agent parked among parked
 ///   neighbours, while its coarse window is reused) is served that solution, which is the
 ///   solve's to the bit (see `Solved`).
@@ -89,7 +86,16 @@ struct Problem {
     free: Vec<bool>,
     /// Dirichlet cells: the ring, the target disc, and every cell that is not free (`W = 0`).
     known: Vec<bool>,
-    /// The Dirichlet values, and the starting guess elsewhere.
+    /// The Dirichlet values, and the starting guess elsewhere: the field of the walls.
+    ///
+    /// Where the others close the way, the coarse window's ring is far below that field (a
+    /// first residual of a median 1e4 and up to 1e9 times the right-hand side, measured on 64
+    /// robots on the 1.8 m circle), and a window took 11.2 iterations to 1e-7 where it took
+    /// about 7 from 0. But 0 is no better start: 64 robots on the 1.2 m circle then arrived
+    /// 3 s later on five seeds of six (22 s on one) with 7–13 robots parked a seed against
+    /// 1–4. Below the solve's precision, in the crowd's shadow, what is left of the field of
+    /// the walls still leads on; what is left of 0 does not. (Whole 57 s run of the 64 on the
+    /// 1.8 m circle from 0: 27.6 s against 33.7 s.)
     values: ScaledW,
 }
 
@@ -192,8 +198,9 @@ pub const WINDOW_TOLERANCE: f64 = 1e-9;
 /// (the whole grid's coarse window in a large room) with W-cycles. On a small grid the W-cycle's
 /// extra visits cost more than the iterations they save: its coarse levels are a few rows of a
 /// few cells each, where a row's overhead outweighs its arithmetic. Measured: 64 robots on the
-/// 1.8 m circle (first 12 s; fine windows 62² cells, coarse ones up to 98²) in 10.7–11.0 s
-/// against 11.4–11.6 s with W-cycles; the paper's room at 101² (to 1e-12) in 4.9 ms with
+/// 1.8 m circle (fine windows 62² cells, coarse ones up to 98²), first 12 s in 12.4–12.7 s
+/// against 13.1–13.6 s with W-cycles, the whole 57 s in 33.7 s against 34.4–37.5 s; the paper's
+/// room at 101² (to 1e-12) in 4.9 ms with
 /// V-cycles (20 iterations) against 5.2 ms (13), but at 201² in 17.2 ms against 11.3. Full
 /// solves keep the W-cycle: the nested levels' parts, small too, took 4 % more iterations (and
 /// up to 3 % more time) with V-cycles on the rooms map's longest field.
@@ -373,9 +380,6 @@ impl Window {
         if !whole && !leads_on(&problem, (grid, reachable, w), (&ir, &jr), position) {
             return Err(unreachable());
         }
-        if coarse.is_some() {
-            zero_start(&mut problem);
-        }
         let last = previous.map(|p| &p.solved);
         let (solved, iterations) =
             Solved::solve(problem, agent, position, (tolerance, Stop::Never), last)?;
@@ -408,24 +412,6 @@ impl Window {
         let fy = (p[1] - g.origin[1]) / g.cell - 0.5;
         let [x, y] = self.interior;
         fx >= x[0] && fx < x[1] && fy >= y[0] && fy < y[1]
-    }
-}
-
-/// Starts `problem`'s solve from 0 on its unknown cells: for a window whose ring comes from a
-/// coarse window. The field of the walls, the starting guess otherwise, is far above that ring
-/// where the others close the way ahead (the coarse window shows the crowd; the walls do not),
-/// and CG then spent its first iterations taking that excess down. Measured on 64 robots on the
-/// 1.8 m circle (first 12 s; windows to 1e-7 for the counts): the first residual was a median
-/// of about 1e4 and up to 1e9 times the right-hand side, and a window took 11.2 iterations. From
-/// 0 the first residual is the right-hand side itself, and a window takes about 7 (its coarse
-/// window's counted in). The coarse window's own values as the guess did no better (6.9
-/// iterations), and sampling them cost 12 % of the run. At 1e-9 the run's first 12 s took
-/// 11.9 s against 12.8 s.
-fn zero_start(problem: &mut Problem) {
-    for k in 0..problem.grid.len() {
-        if !problem.known[k] {
-            (problem.values.mantissa[k], problem.values.exponent[k]) = (0.0, 0);
-        }
     }
 }
 
