@@ -180,7 +180,8 @@ pub const COARSE: usize = 4;
 /// replan (twice a second at 10 Hz).
 ///
 /// Not more: 9 saved about a tenth of 32 robots' wall time on the 1.8 m circle, but the last
-/// robot settled 26.2 → 29.3 s later on average over ten seeds (a staler ring steers worse).
+/// robot settled 25.8 → 29.3 s on average over ten seeds (a staler ring steers worse; both
+/// measured with windows started from 0, see `Problem`).
 pub const COARSE_REUSE: u32 = 4;
 
 /// The relative residual a window is solved to, unless the field's own tolerance is looser:
@@ -190,8 +191,9 @@ pub const COARSE_REUSE: u32 = 4;
 ///
 /// Not looser: 1e-7 saved about a tenth of a crowd's time, but it leaves one digit at the depth
 /// the nested levels take over from ([`DEPTH_STEP`], 1e-6), and the guidance there steers
-/// worse. With 1e-7 and a coarse window reused 9 times, 16 robots on the 2.5 m circle settled
-/// 17.8 → 18.9 s on average over ten seeds, 32 robots 30.5 → 32.2 s.
+/// worse. With 1e-7, a coarse window reused 9 times and windows started from 0, 16 robots on
+/// the 2.5 m circle settled 17.8 → 18.9 s on average over ten seeds, 32 robots 30.5 → 32.2 s;
+/// with those two alone (windows from the walls' field), the shipped `circle-16` 18.4 → 22.8 s.
 pub const WINDOW_TOLERANCE: f64 = 1e-9;
 
 /// A window at most this many cells along each side is solved with V-cycles, a larger one
@@ -200,10 +202,10 @@ pub const WINDOW_TOLERANCE: f64 = 1e-9;
 /// few cells each, where a row's overhead outweighs its arithmetic. Measured: 64 robots on the
 /// 1.8 m circle (fine windows 62² cells, coarse ones up to 98²), first 12 s in 12.4–12.7 s
 /// against 13.1–13.6 s with W-cycles, the whole 57 s in 33.7 s against 34.4–37.5 s; the paper's
-/// room at 101² (to 1e-12) in 4.9 ms with
-/// V-cycles (20 iterations) against 5.2 ms (13), but at 201² in 17.2 ms against 11.3. Full
-/// solves keep the W-cycle: the nested levels' parts, small too, took 4 % more iterations (and
-/// up to 3 % more time) with V-cycles on the rooms map's longest field.
+/// room at 101² (to 1e-12) in 4.9 ms with V-cycles (20 iterations) against 5.2 ms (13), but at
+/// 201² in 17.2 ms against 11.3. Full solves keep the W-cycle: the nested levels' parts, small
+/// too, took 4 % more iterations (and up to 3 % more time) with V-cycles on the rooms map's
+/// longest field.
 pub const V_CYCLE_SIDE: usize = 128;
 
 /// How far the coarse window that gives a window's edge extends.
