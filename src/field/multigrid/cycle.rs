@@ -31,6 +31,7 @@ impl Cycle {
         }
     }
 }
+
 /// A level with at most this many unknowns is solved exactly.
 const COARSEST: usize = 64;
 /// A level at least this many rows tall is swept by two threads (see [`Part`]): the fine levels
