@@ -48,7 +48,8 @@ use crate::world::Agent;
 ///   tighter solve changes, and it takes about a third fewer iterations than 1e-12 (see
 ///   `WINDOW_TOLERANCE`). Cells below what the solve resolves go to the nested levels, as in
 ///   a full solve.
-/// - The unknown cells start from the field of the walls (see `Problem`).
+/// - The unknown cells start from 0 when a coarse window gives the ring, else from the field
+///   of the walls (see `zero_start`).
 /// - A replan that sets the very problem the last one solved (an agent parked among parked
 ///   neighbours, while its coarse window is reused) is served that solution, which is the
 ///   solve's to the bit (see `Solved`).
@@ -86,16 +87,8 @@ struct Problem {
     free: Vec<bool>,
     /// Dirichlet cells: the ring, the target disc, and every cell that is not free (`W = 0`).
     known: Vec<bool>,
-    /// The Dirichlet values, and the starting guess elsewhere: the field of the walls.
-    ///
-    /// Where the others close the way, the coarse window's ring is far below that field (a
-    /// first residual of a median 1e4 and up to 1e9 times the right-hand side, measured on 64
-    /// robots on the 1.8 m circle), and a window took 11.2 iterations to 1e-7 where it took
-    /// about 7 from 0. But 0 is no better start: 64 robots on the 1.2 m circle then arrived
-    /// 3 s later on five seeds of six (22 s on one) with 7–13 robots parked a seed against
-    /// 1–4. Below the solve's precision, in the crowd's shadow, what is left of the field of
-    /// the walls still leads on; what is left of 0 does not. (Whole 57 s run of the 64 on the
-    /// 1.8 m circle from 0: 27.6 s against 33.7 s.)
+    /// The Dirichlet values, and the starting guess elsewhere: the field of the walls, or 0
+    /// in a window whose ring comes from a coarse window (see `zero_start`).
     values: ScaledW,
 }
 
@@ -382,6 +375,9 @@ impl Window {
         if !whole && !leads_on(&problem, (grid, reachable, w), (&ir, &jr), position) {
             return Err(unreachable());
         }
+        if coarse.is_some() {
+            zero_start(&mut problem);
+        }
         let last = previous.map(|p| &p.solved);
         let (solved, iterations) =
             Solved::solve(problem, agent, position, (tolerance, Stop::Never), last)?;
@@ -414,6 +410,30 @@ impl Window {
         let fy = (p[1] - g.origin[1]) / g.cell - 0.5;
         let [x, y] = self.interior;
         fx >= x[0] && fx < x[1] && fy >= y[0] && fy < y[1]
+    }
+}
+
+/// Starts `problem`'s solve from 0 on its unknown cells: for a window whose ring comes from a
+/// coarse window. Where the others close the way, that ring is far below the field of the
+/// walls (the coarse window shows the crowd, the walls do not), and from that field the first
+/// residual was a median 1e4 and up to 1e9 times the right-hand side (64 robots on the 1.8 m
+/// circle). CG's recurrence then drifted from the true residual: 11 % of the windows ended
+/// above 1e-8 of it, up to 3e-6, reported under 1e-9 (the solver now recomputes the residual
+/// and restarts, see `multigrid::solve`). From 0 the first residual is the right-hand side:
+/// 12.2 iterations a window against 17.8, and the whole 57 s run in 28.1 s against 31.7 s.
+///
+/// The accurate field steers the densest crowds differently from the drifted one, whose error
+/// had the walls' shape and led on through the crowd's shadow: 64 robots on the 1.2 m circle
+/// (seeds 0–5) settle last at 38.5–40.5 s, 59.0 s on one seed, against 35.0–43.5 s, with
+/// 7–13 robots flagged parked a seed against 1–5. With the walls' field as the guess solved
+/// to 1e-11 (still drifted), 0–4 on seeds 0–2; from 0 to 1e-11, 8–13; from 0 with the nested
+/// levels' floor scaled to the window's tolerance, 6–11 on seeds 0–1. The crowd checks are in
+/// the README.
+fn zero_start(problem: &mut Problem) {
+    for k in 0..problem.grid.len() {
+        if !problem.known[k] {
+            (problem.values.mantissa[k], problem.values.exponent[k]) = (0.0, 0);
+        }
     }
 }
 
