@@ -210,7 +210,8 @@ impl HarmonicField {
     /// agent's last field. `None` where the coarse window around the agent (`replan_reach`)
     /// already covers the grid: the wide window would be the window's own problem again, and
     /// what is left to tell them apart is the coarse cell, which only the full re-solve
-    /// resolves.
+    /// resolves. When `self`'s window is the last replan's wide window, its field over the
+    /// whole grid may serve again (see [`Reach::Whole`]); an ordinary window's never does.
     ///
     /// ```
     /// # let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/room-two-dividers.toml");
