@@ -17,6 +17,27 @@ use nadf::cli::{
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+// mimalloc's C API (linked with the allocator), for the one option set in `main`.
+unsafe extern "C" {
+    fn mi_option_set(option: std::ffi::c_int, value: std::ffi::c_long);
+}
+
+/// `mi_option_purge_delay` in mimalloc 3's `mi_option_e` (`include/mimalloc.h` of the
+/// `libmimalloc-sys` the lock file pins): how long freed memory waits before it is handed
+/// back to the kernel, ms; -1 never.
+const MI_OPTION_PURGE_DELAY: std::ffi::c_int = 15;
+
+/// Keeps the memory a command frees for its next allocations instead of handing it back to
+/// the kernel: the nested levels of a deep field allocate and free a part's buffers thousands
+/// of times, and memory handed back is faulted in again as zeroed huge pages (`clear_page`
+/// was a tenth of the rooms map's longest field). Measured there (`nadf field`, alternating
+/// runs): 12.1–12.2 s against 13.8 s, half the system time; the process keeps its peak
+/// memory until it exits.
+fn keep_freed_memory() {
+    // SAFETY: sets a plain integer option, before any other thread runs.
+    unsafe { mi_option_set(MI_OPTION_PURGE_DELAY, -1) };
+}
+
 #[derive(Parser)]
 #[command(
     name = "nadf",
@@ -57,6 +78,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    keep_freed_memory();
     let command = Cli::parse().command;
     let console = Console::new();
     let result = match &command {

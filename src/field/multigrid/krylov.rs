@@ -51,7 +51,9 @@ impl Krylov {
             }
         }
         // r = b − A x row by row, trailing two rows behind so that `fixed` (read up to a row
-        // ahead) can be overwritten with r.
+        // ahead) can be overwritten with r. Only a row's span holds active cells (a nested
+        // part's box is mostly empty); the sums skip only zeros, so they are those over the
+        // whole row to the bit.
         let (mut bb, mut rr) = (0.0, 0.0);
         let mut rows = [vec![0.0; nx], vec![0.0; nx]];
         for j in 0..ny + 2 {
@@ -65,22 +67,19 @@ impl Krylov {
                 let u = Neighbourhood::of(&x, k, nx, stride);
                 let d = &fine.inv_diag[k..k + nx];
                 let row = &mut rows[j % 2];
+                row.fill(0.0);
                 let mut b_row = 0.0;
-                for i in 0..nx {
-                    let (b, r) = if d[i] != 0.0 {
-                        let b = f.west[i] + f.east[i] + f.up[i] + f.down[i];
-                        (
-                            b,
-                            b - (4.0 * u.mid[i] - u.west[i] - u.east[i] - u.up[i] - u.down[i]),
-                        )
-                    } else {
-                        (0.0, 0.0)
-                    };
-                    b_row += b * b;
-                    row[i] = r;
+                for i in fine.span(j) {
+                    if d[i] != 0.0 {
+                        let f = [f.west[i], f.east[i], f.up[i], f.down[i]];
+                        let (b, r) =
+                            residual_at(f, [u.mid[i], u.west[i], u.east[i], u.up[i], u.down[i]]);
+                        b_row += b * b;
+                        row[i] = r;
+                    }
                 }
                 bb += b_row;
-                rr += dot(row, row);
+                rr += row_dot(row, fine.span(j));
             }
         }
         Self {
@@ -96,11 +95,58 @@ impl Krylov {
 
     /// `‖r‖ / ‖b‖` (`‖r‖` when `b` is 0).
     fn relative(&self) -> f64 {
+        self.relative_of(self.rr)
+    }
+
+    /// `sqrt(rr) / ‖b‖` (`sqrt(rr)` when `b` is 0).
+    fn relative_of(&self, rr: f64) -> f64 {
         if self.norm_b > 0.0 {
-            self.rr.sqrt() / self.norm_b
+            rr.sqrt() / self.norm_b
         } else {
-            self.rr.sqrt()
+            rr.sqrt()
         }
+    }
+
+    /// The relative residual `‖b − A x‖ / ‖b‖` recomputed from the solution (not CG's
+    /// recurrence), with the Dirichlet values read from `values` as [`Krylov::start`] reads
+    /// them: to the bit what a new start from the solution would measure, without its
+    /// vectors (a nested part's solve is mostly that check).
+    pub fn true_relative(
+        &self,
+        fine: &Level,
+        grid: &Grid,
+        unknown: &[bool],
+        values: &[f64],
+    ) -> f64 {
+        let (nx, ny) = (grid.nx, grid.ny);
+        // A Dirichlet value around cell (i, j) as `start` holds it: 0 on unknown cells and
+        // off the grid.
+        let fixed = |i: usize, j: usize| {
+            let k = j * nx + i;
+            if unknown[k] { 0.0 } else { values[k] }
+        };
+        let mut row = vec![0.0; nx];
+        let mut rr = 0.0;
+        for j in 0..ny {
+            let k = fine.pad(0, j);
+            let u = Neighbourhood::of(&self.x, k, nx, fine.stride);
+            let d = &fine.inv_diag[k..k + nx];
+            for i in fine.span(j) {
+                if d[i] != 0.0 {
+                    let f = [
+                        if i > 0 { fixed(i - 1, j) } else { 0.0 },
+                        if i + 1 < nx { fixed(i + 1, j) } else { 0.0 },
+                        if j + 1 < ny { fixed(i, j + 1) } else { 0.0 },
+                        if j > 0 { fixed(i, j - 1) } else { 0.0 },
+                    ];
+                    let u = [u.mid[i], u.west[i], u.east[i], u.up[i], u.down[i]];
+                    row[i] = residual_at(f, u).1;
+                }
+            }
+            rr += row_dot(&row, fine.span(j));
+            row[fine.span(j)].fill(0.0);
+        }
+        self.relative_of(rr)
     }
 
     /// Preconditioned CG until the relative residual is at most `tolerance` or
@@ -315,5 +361,90 @@ fn apply_row(level: &Level, (q, origin): (&[f32], usize), j: usize, out: &mut [f
             - f64::from(q.east[i])
             - f64::from(q.up[i])
             - f64::from(q.down[i]);
+    }
+}
+
+/// The right-hand side `b` and the residual `b − A x` at an active cell of the fine level,
+/// from its neighbours' Dirichlet values `f` (west, east, north, south; 0 on unknown cells
+/// and off the grid) and the values `u` of the cell and of its neighbours (centre, west, east,
+/// north, south; 0 on Dirichlet cells).
+#[inline(always)]
+fn residual_at(f: [f64; 4], u: [f64; 5]) -> (f64, f64) {
+    let b = f[0] + f[1] + f[2] + f[3];
+    (b, b - (4.0 * u[0] - u[1] - u[2] - u[3] - u[4]))
+}
+
+/// `row · row` for a row whose cells outside `span` are 0: the sum [`dot`] gives over the
+/// whole row, to the bit (it starts at the chunk of four that holds the span's first cell and
+/// runs to the row's end, so every cell falls in the same partial sum; the cells it skips add
+/// only zeros).
+#[inline(always)]
+fn row_dot(row: &[f64], span: Range<usize>) -> f64 {
+    if span.is_empty() {
+        return 0.0;
+    }
+    let from = span.start / 4 * 4;
+    dot(&row[from..], &row[from..])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::multigrid::Cycle;
+
+    /// A row's sum over its span is the whole row's to the bit, wherever the span starts.
+    #[test]
+    fn a_span_sums_as_its_whole_row() {
+        let n = 23;
+        for start in 0..n {
+            for end in start..=n {
+                let row: Vec<f64> = (0..n)
+                    .map(|i| {
+                        let v = ((i * 7919 % 1013) as f64).sqrt() / 3.0;
+                        if (start..end).contains(&i) { v } else { 0.0 }
+                    })
+                    .collect();
+                let (span, whole) = (row_dot(&row, start..end), dot(&row, &row));
+                assert_eq!(span.to_bits(), whole.to_bits(), "{start}..{end}");
+            }
+        }
+    }
+
+    /// A ring of unknown cells in a box (rows whose span holds a hole, rows with no unknown
+    /// cell), uneven Dirichlet values around it: after each of a few iterations, the check
+    /// measures the residual of the solution to the bit as a new start from it does, which
+    /// the solve relies on to stop where it stopped before the check.
+    #[test]
+    fn the_check_measures_what_a_new_start_would_to_the_bit() {
+        let grid = Grid {
+            nx: 37,
+            ny: 29,
+            cell: 1.0,
+            origin: [0.0, 0.0],
+        };
+        let unknown: Vec<bool> = (0..grid.len())
+            .map(|k| {
+                let (i, j) = ((k % grid.nx) as f64, (k / grid.nx) as f64);
+                (6.0..11.0).contains(&(i - 17.0).hypot(j - 13.0))
+            })
+            .collect();
+        let mut values: Vec<f64> = (0..grid.len())
+            .map(|k| (((k * 7919) % 1013) as f64).sqrt() / 32.0)
+            .collect();
+        let mut h = Hierarchy::new(grid.nx, grid.ny, &unknown, Cycle::V);
+        let mut cg = Krylov::start(&h.levels[0], &grid, &unknown, &values);
+        for _ in 0..3 {
+            let run = cg.iterate(&mut h, 1e-30, 1);
+            assert_eq!(run.iterations, 1);
+            cg.copy_out(&h.levels[0], &grid, &unknown, &mut values);
+            let check = cg.true_relative(&h.levels[0], &grid, &unknown, &values);
+            let fresh = Krylov::start(&h.levels[0], &grid, &unknown, &values).relative();
+            assert!(check > 0.0);
+            assert_eq!(
+                check.to_bits(),
+                fresh.to_bits(),
+                "{check:e} against {fresh:e}"
+            );
+        }
     }
 }
