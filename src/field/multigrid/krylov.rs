@@ -109,8 +109,9 @@ impl Krylov {
 
     /// The relative residual `‖b − A x‖ / ‖b‖` recomputed from the solution (not CG's
     /// recurrence), with the Dirichlet values read from `values` as [`Krylov::start`] reads
-    /// them: to the bit what a new start from the solution would measure, without its
-    /// vectors (a nested part's solve is mostly that check).
+    /// them: to the bit what a new start from the solution would measure, over the rows'
+    /// spans only and without a new start's vectors over the whole box (a nested part's box
+    /// is mostly empty).
     pub fn true_relative(
         &self,
         fine: &Level,
