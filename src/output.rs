@@ -32,11 +32,46 @@ pub fn partial_path(path: &Path) -> PathBuf {
     PathBuf::from(partial)
 }
 
+/// What a command writes to a file: its bytes, or a writer of them (a large array written a
+/// piece at a time rather than held whole in memory).
+pub enum Contents<'a> {
+    /// The file's bytes.
+    Bytes(Vec<u8>),
+    /// Writes the file's bytes to the writer it is given.
+    Stream(Box<Writer<'a>>),
+}
+
+/// Writes a file's bytes to the writer it is given (see [`Contents::Stream`]).
+pub type Writer<'a> = dyn Fn(&mut dyn Write) -> std::io::Result<()> + Send + Sync + 'a;
+
+impl From<Vec<u8>> for Contents<'_> {
+    fn from(bytes: Vec<u8>) -> Self {
+        Self::Bytes(bytes)
+    }
+}
+
 /// Writes `bytes` to `OUT.partial`, then renames it to `path`.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    write_with(path, |f| f.write_all(bytes))
+}
+
+/// Writes `contents` to `OUT.partial`, then renames it to `path` (see [`write_atomically`]).
+pub fn write_contents(path: &Path, contents: &Contents) -> Result<(), OutputError> {
+    match contents {
+        Contents::Bytes(bytes) => write_atomically(path, bytes),
+        Contents::Stream(write) => write_with(path, |f| write(f)),
+    }
+}
+
+/// Creates `OUT.partial`, has `write` fill it, syncs it and renames it to `path`; on any
+/// failure removes it.
+fn write_with(
+    path: &Path,
+    write: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
+) -> Result<(), OutputError> {
     let partial = partial_path(path);
     let result = std::fs::File::create(&partial)
-        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
+        .and_then(|mut f| write(&mut f).and_then(|()| f.sync_all()))
         .and_then(|()| std::fs::rename(&partial, path));
     if let Err(e) = result {
         let _ = std::fs::remove_file(&partial);
@@ -138,5 +173,27 @@ mod tests {
         assert!(!partial_path(&file).exists());
         let err = write_atomically(&dir.path().join("no/out.csv"), b"x").unwrap_err();
         assert!(err.to_string().contains("cannot write"), "{err}");
+    }
+
+    /// A streamed file that fails part way leaves neither its partial file nor a file at its
+    /// path (the good one there stays); one that succeeds is whole.
+    #[test]
+    fn a_stream_that_fails_leaves_the_old_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("out.npy");
+        write_atomically(&file, b"old").unwrap();
+        let failing = Contents::Stream(Box::new(|out: &mut dyn Write| {
+            out.write_all(b"half")?;
+            Err(std::io::Error::other("disk full"))
+        }));
+        let err = write_contents(&file, &failing).unwrap_err();
+        assert!(err.to_string().contains("disk full"), "{err}");
+        assert_eq!(std::fs::read(&file).unwrap(), b"old");
+        assert!(!partial_path(&file).exists());
+        let pieces = Contents::Stream(Box::new(|out: &mut dyn Write| {
+            (0..3).try_for_each(|i| out.write_all(&[b'a' + i]))
+        }));
+        write_contents(&file, &pieces).unwrap();
+        assert_eq!(std::fs::read(&file).unwrap(), b"abc");
     }
 }

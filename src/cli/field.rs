@@ -3,8 +3,9 @@
 use std::path::PathBuf;
 
 use super::{Failure, bad_input, load, write_all};
+use crate::field::export::FieldArray;
 use crate::field::{HarmonicField, PoseField, export};
-use crate::output;
+use crate::output::{self, Contents};
 use crate::record::field_picture;
 use crate::world::{BodyShape, FieldKind, Override};
 
@@ -111,16 +112,24 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         "1 - V at the start: {}",
         scientific(field.log10_one_minus_potential(agent.start))
     );
-    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-    if let Some([v, w, log, mask]) = npy {
-        files.push((v, export::potential_npy(&field)));
-        files.push((w, export::one_minus_potential_npy(&field)));
-        files.push((log, export::log10_one_minus_potential_npy(&field)));
-        files.push((mask, export::mask_npy(&field)));
+    let mut files: Vec<(PathBuf, Contents)> = Vec::new();
+    if let Some(paths) = npy {
+        // Each array written a few columns at a time as its file goes out (see `write_all`).
+        let arrays = [
+            FieldArray::Potential,
+            FieldArray::OneMinusPotential,
+            FieldArray::Log10OneMinusPotential,
+            FieldArray::Mask,
+        ];
+        let field = &field;
+        files.extend(paths.into_iter().zip(arrays).map(|(path, array)| {
+            let write = move |out: &mut dyn std::io::Write| export::write_array(field, array, out);
+            (path, Contents::Stream(Box::new(write)))
+        }));
     }
     if let Some(png) = &args.png {
         let (rgb, width, height) = field_picture(&field, agent);
-        files.push((png.clone(), export::png(&rgb, width, height)));
+        files.push((png.clone(), export::png(&rgb, width, height).into()));
     }
     write_all(path, files)
 }

@@ -6,6 +6,8 @@
 //! An arm's has one axis per joint, `[cells, cells(, cells)]`: element `[k₁, k₂(, k₃)]` is the
 //! cell of those joint cells (see [`super::JointAxis::center`]).
 
+use std::io::Write;
+
 use super::grid::Grid;
 use super::{HarmonicField, JointField, PoseField, ScaledW};
 
@@ -21,19 +23,60 @@ pub enum CellClass {
     Unreachable = 2,
 }
 
-/// An `.npy` file (format 1.0) holding a C-ordered `[nx, ny]` array of `descr` elements.
-fn npy(grid: &Grid, descr: &str, element_bytes: usize, data: impl Fn(usize) -> Vec<u8>) -> Vec<u8> {
-    let cells = (0..grid.nx).flat_map(|i| (0..grid.ny).map(move |j| grid.index(i, j)));
-    npy_of(&[grid.nx, grid.ny], descr, element_bytes, cells.map(data))
+/// Columns of the grid a tile of [`write_npy`] takes at once: the grid's rows are read across
+/// the tile and the array's rows (one per column) written down it, both in cache. Element by
+/// element in the array's order, each read was a row apart (8 kB at 1025²).
+const TILE: usize = 16;
+
+/// Writes an `.npy` file (format 1.0) of a C-ordered `[nx, ny]` array to `out`: element
+/// `[i, j]` is `element(grid.index(i, j))`, `B` bytes of `descr`. It goes out a tile of
+/// [`TILE`] columns at a time, so a file is never held whole in memory (at 1025², the four
+/// arrays of a field were 25 MB, every page of it faulted in fresh).
+fn write_npy<const B: usize>(
+    out: &mut dyn Write,
+    grid: &Grid,
+    descr: &str,
+    element: impl Fn(usize) -> [u8; B],
+) -> std::io::Result<()> {
+    out.write_all(&npy_header(&[grid.nx, grid.ny], descr))?;
+    let mut tile = vec![0; TILE.min(grid.nx) * grid.ny * B];
+    for i0 in (0..grid.nx).step_by(TILE) {
+        let columns = i0..(i0 + TILE).min(grid.nx);
+        for j in 0..grid.ny {
+            for (c, i) in columns.clone().enumerate() {
+                let at = (c * grid.ny + j) * B;
+                tile[at..at + B].copy_from_slice(&element(grid.index(i, j)));
+            }
+        }
+        out.write_all(&tile[..columns.len() * grid.ny * B])?;
+    }
+    Ok(())
+}
+
+/// What `write` writes, in memory.
+fn in_memory(write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Vec<u8> {
+    let mut out = Vec::new();
+    write(&mut out).expect("writing to memory");
+    out
 }
 
 /// An `.npy` file of a C-ordered array of `shape`, its elements' bytes in that order.
-fn npy_of(
+fn npy_of<const B: usize>(
     shape: &[usize],
     descr: &str,
-    element_bytes: usize,
-    elements: impl Iterator<Item = Vec<u8>>,
+    elements: impl Iterator<Item = [u8; B]>,
 ) -> Vec<u8> {
+    let mut out = npy_header(shape, descr);
+    out.reserve(shape.iter().product::<usize>() * B);
+    for e in elements {
+        out.extend_from_slice(&e);
+    }
+    out
+}
+
+/// The header of an `.npy` file of a C-ordered array of `shape` of `descr`: the magic string,
+/// the version, the header's length and the header, padded to a multiple of 64 bytes.
+fn npy_header(shape: &[usize], descr: &str) -> Vec<u8> {
     let dims: Vec<String> = shape.iter().map(ToString::to_string).collect();
     let mut header = format!(
         "{{'descr': '{descr}', 'fortran_order': False, 'shape': ({}), }}",
@@ -43,14 +86,9 @@ fn npy_of(
     let unpadded = 10 + header.len() + 1;
     header.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
     header.push('\n');
-    let len: usize = shape.iter().product();
-    let mut out = Vec::with_capacity(10 + header.len() + len * element_bytes);
-    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    let mut out = b"\x93NUMPY\x01\x00".to_vec();
     out.extend_from_slice(&(header.len() as u16).to_le_bytes());
     out.extend_from_slice(header.as_bytes());
-    for e in elements {
-        out.extend_from_slice(&e);
-    }
     out
 }
 
@@ -91,19 +129,13 @@ fn four_arrays(
             f64::NEG_INFINITY
         }
     };
-    let f8 = |f: &dyn Fn(usize) -> f64| {
-        npy_of(
-            shape,
-            "<f8",
-            8,
-            cells.clone().map(|c| f(c).to_le_bytes().to_vec()),
-        )
-    };
+    let f8 =
+        |f: &dyn Fn(usize) -> f64| npy_of(shape, "<f8", cells.clone().map(|c| f(c).to_le_bytes()));
     [
         f8(&|c| 1.0 - value(c)),
         f8(&value),
         f8(&log),
-        npy_of(shape, "|u1", 1, cells.clone().map(|c| vec![class(c) as u8])),
+        npy_of(shape, "|u1", cells.clone().map(|c| [class(c) as u8])),
     ]
 }
 
@@ -132,45 +164,79 @@ pub fn joint_arrays(field: &JointField) -> [Vec<u8>; 4] {
     )
 }
 
-/// `V = 1 − W` per cell as little-endian float64 (exactly 1 where `W` is below 1e-16).
+/// The four arrays of a disc's field that `nadf field --npy` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FieldArray {
+    /// `V = 1 − W` per cell as little-endian float64 (exactly 1 where `W` is below 1e-16).
+    Potential,
+    /// `W = 1 − V` per cell as little-endian float64, with full relative precision down to
+    /// f64's range (0 below 1e-308: see [`FieldArray::Log10OneMinusPotential`]).
+    OneMinusPotential,
+    /// `log10 W` per cell as little-endian float64, at any depth (−inf on blocked and
+    /// unreachable cells).
+    Log10OneMinusPotential,
+    /// The mask as uint8: one [`CellClass`] per cell.
+    Mask,
+}
+
+/// Writes `array` of `field` to `out` as an `.npy` file of shape `[nx, ny]`, a few columns at a
+/// time (a file is never held whole).
+///
+/// ```
+/// # let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/room-two-dividers.toml");
+/// # let world = nadf::world::load(&path, &["field.cell=0.1".parse().unwrap()]).unwrap();
+/// use nadf::field::export::{FieldArray, write_array};
+/// let field = nadf::field::HarmonicField::solve(&world, &world.agents[0]).unwrap();
+/// let mut out = Vec::new();
+/// write_array(&field, FieldArray::Mask, &mut out).unwrap();
+/// assert_eq!(out.len(), 128 + field.grid().len());
+/// ```
+pub fn write_array(
+    field: &HarmonicField,
+    array: FieldArray,
+    out: &mut dyn Write,
+) -> std::io::Result<()> {
+    let (grid, w) = (field.grid(), field.sampler.values());
+    match array {
+        FieldArray::Potential => write_npy(out, grid, "<f8", |k| (1.0 - w.value(k)).to_le_bytes()),
+        FieldArray::OneMinusPotential => write_npy(out, grid, "<f8", |k| w.value(k).to_le_bytes()),
+        FieldArray::Log10OneMinusPotential => {
+            write_npy(out, grid, "<f8", |k| w.log10(k).to_le_bytes())
+        }
+        FieldArray::Mask => {
+            let reachable = field.sampler.reachable_cells();
+            write_npy(out, grid, "|u1", |k| {
+                let class = if field.blocked[k] {
+                    CellClass::Blocked
+                } else if reachable[k] {
+                    CellClass::Reachable
+                } else {
+                    CellClass::Unreachable
+                };
+                [class as u8]
+            })
+        }
+    }
+}
+
+/// [`FieldArray::Potential`] of `field`, in memory.
 pub fn potential_npy(field: &HarmonicField) -> Vec<u8> {
-    let w = field.sampler.values();
-    npy(field.grid(), "<f8", 8, |k| {
-        (1.0 - w.value(k)).to_le_bytes().to_vec()
-    })
+    in_memory(|out| write_array(field, FieldArray::Potential, out))
 }
 
-/// `W = 1 − V` per cell as little-endian float64, with full relative precision down to f64's
-/// range (0 below 1e-308: see [`log10_one_minus_potential_npy`]).
+/// [`FieldArray::OneMinusPotential`] of `field`, in memory.
 pub fn one_minus_potential_npy(field: &HarmonicField) -> Vec<u8> {
-    let w = field.sampler.values();
-    npy(field.grid(), "<f8", 8, |k| {
-        w.value(k).to_le_bytes().to_vec()
-    })
+    in_memory(|out| write_array(field, FieldArray::OneMinusPotential, out))
 }
 
-/// `log10 W` per cell as little-endian float64, at any depth (−inf on blocked and unreachable
-/// cells).
+/// [`FieldArray::Log10OneMinusPotential`] of `field`, in memory.
 pub fn log10_one_minus_potential_npy(field: &HarmonicField) -> Vec<u8> {
-    let w = field.sampler.values();
-    npy(field.grid(), "<f8", 8, |k| {
-        w.log10(k).to_le_bytes().to_vec()
-    })
+    in_memory(|out| write_array(field, FieldArray::Log10OneMinusPotential, out))
 }
 
-/// The mask as uint8: one [`CellClass`] per cell.
+/// [`FieldArray::Mask`] of `field`, in memory.
 pub fn mask_npy(field: &HarmonicField) -> Vec<u8> {
-    let reachable = field.sampler.reachable_cells();
-    npy(field.grid(), "|u1", 1, |k| {
-        let class = if field.blocked[k] {
-            CellClass::Blocked
-        } else if reachable[k] {
-            CellClass::Reachable
-        } else {
-            CellClass::Unreachable
-        };
-        vec![class as u8]
-    })
+    in_memory(|out| write_array(field, FieldArray::Mask, out))
 }
 
 /// The paths of the four arrays `--npy FILE` writes: `FILE` (V), `FILE.w.npy`,
@@ -210,7 +276,7 @@ mod tests {
     #[test]
     fn npy_headers_are_aligned_and_the_data_is_x_major() {
         let grid = Grid::covering([0.3, 0.2], 0.1);
-        let bytes = npy(&grid, "|u1", 1, |k| vec![k as u8]);
+        let bytes = in_memory(|out| write_npy(out, &grid, "|u1", |k| [k as u8]));
         assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
         let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
         assert_eq!((10 + header_len) % 64, 0);
@@ -221,6 +287,25 @@ mod tests {
         );
         // [i, j] order: (0,0), (0,1), (1,0), … with k = j·nx + i.
         assert_eq!(&bytes[10 + header_len..], &[0, 3, 1, 4, 2, 5]);
+    }
+
+    /// Columns beyond a tile's, elements of several bytes: the array is still x-major, element
+    /// by element.
+    #[test]
+    fn tiles_keep_the_arrays_order() {
+        let grid = Grid {
+            nx: 2 * TILE + 5,
+            ny: 7,
+            cell: 1.0,
+            origin: [0.0, 0.0],
+        };
+        let bytes = in_memory(|out| write_npy(out, &grid, "<u2", |k| (k as u16).to_le_bytes()));
+        let data = &bytes[bytes.len() - 2 * grid.len()..];
+        let expected: Vec<u8> = (0..grid.nx)
+            .flat_map(|i| (0..grid.ny).map(move |j| j * grid.nx + i))
+            .flat_map(|k| (k as u16).to_le_bytes())
+            .collect();
+        assert_eq!(data, &expected[..]);
     }
 
     #[test]

@@ -95,6 +95,33 @@ impl Coarsest {
     }
 }
 
+/// The levels below a finest level, and the exact solve of the coarsest of all: what
+/// [`Hierarchy::on`] adds to the finest level. Built apart from it so that a tall grid's CG
+/// start can fault in its vectors on the other thread meanwhile (see `solve_all`).
+pub struct Coarse {
+    /// The coarse levels, finest first.
+    levels: Vec<Level>,
+    coarsest: Coarsest,
+}
+
+impl Coarse {
+    /// The coarse levels of `fine`: each the Galerkin coarsening of the one before, down to
+    /// [`COARSEST`] unknowns or a 2 × 2 grid.
+    pub fn of(fine: &Level) -> Self {
+        let mut levels: Vec<Level> = Vec::new();
+        loop {
+            let last = levels.last().unwrap_or(fine);
+            if last.unknowns <= COARSEST || (last.nx <= 2 && last.ny <= 2) {
+                break;
+            }
+            let coarse = last.coarsen();
+            levels.push(coarse);
+        }
+        let coarsest = Coarsest::new(levels.last().unwrap_or(fine));
+        Self { levels, coarsest }
+    }
+}
+
 /// The hierarchy and its work vectors.
 pub struct Hierarchy {
     /// The levels, finest first.
@@ -117,17 +144,23 @@ pub struct Hierarchy {
 
 impl Hierarchy {
     /// The hierarchy of the `nx × ny` grid's `unknown` cells, preconditioning with `cycle`.
+    #[cfg(test)]
     pub fn new(nx: usize, ny: usize, unknown: &[bool], cycle: Cycle) -> Self {
-        let mut levels = vec![Level::finest(nx, ny, unknown)];
-        loop {
-            let last = levels.last().expect("one level");
-            if last.unknowns <= COARSEST || (last.nx <= 2 && last.ny <= 2) {
-                break;
-            }
-            let coarse = last.coarsen();
-            levels.push(coarse);
-        }
-        let coarsest = Coarsest::new(levels.last().expect("one level"));
+        let fine = Level::finest(nx, ny, unknown);
+        let coarse = Coarse::of(&fine);
+        Self::on(fine, coarse, cycle)
+    }
+
+    /// The hierarchy of the finest level `fine`, with its `coarse` levels, preconditioning
+    /// with `cycle`.
+    pub fn on(fine: Level, coarse: Coarse, cycle: Cycle) -> Self {
+        let (nx, ny) = (fine.nx, fine.ny);
+        let Coarse {
+            levels: coarse,
+            coarsest,
+        } = coarse;
+        let mut levels = vec![fine];
+        levels.extend(coarse);
         let work = levels
             .iter()
             .map(|l| [vec![0.0; l.len()], vec![0.0; l.len()]])

@@ -68,8 +68,9 @@ pub use cycle::Cycle;
 pub use kernels::set_portable;
 
 use super::grid::Grid;
-use cycle::Hierarchy;
+use cycle::{Coarse, Hierarchy, split_at};
 use krylov::Krylov;
+use level::Level;
 
 /// How a solve went.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,7 +119,20 @@ fn solve_all(
     tolerance: f64,
     max_iterations: usize,
 ) -> Stats {
-    let mut hierarchy = Hierarchy::new(grid.nx, grid.ny, unknown, cycle);
+    // The coarse levels and CG's start each fault in fresh memory (most of their time on a
+    // large grid): on a tall one, the two threads build them at once.
+    let fine = Level::finest(grid.nx, grid.ny, unknown);
+    let (coarse, mut cg) = match split_at(&fine) {
+        Some(_) => rayon::join(
+            || Coarse::of(&fine),
+            || Krylov::start(&fine, grid, unknown, values),
+        ),
+        None => (
+            Coarse::of(&fine),
+            Krylov::start(&fine, grid, unknown, values),
+        ),
+    };
+    let mut hierarchy = Hierarchy::on(fine, coarse, cycle);
     let mut stats = Stats {
         iterations: 0,
         relative_residual: f64::NAN,
@@ -129,8 +143,6 @@ fn solve_all(
     // reaches the tolerance while `b − A x` is still orders of magnitude above it. So the
     // residual is recomputed from the solution, and CG restarted from it while that is above
     // the tolerance (a NaN or an exhausted budget ends the solve as it is).
-    let fine = &hierarchy.levels[0];
-    let mut cg = Krylov::start(fine, grid, unknown, values);
     for restart in 0..=RESTARTS {
         let left = max_iterations - stats.iterations;
         let run = cg.iterate(&mut hierarchy, tolerance, left);
