@@ -238,6 +238,10 @@ pub fn solve_levels(
     tolerance: f64,
     stop: &Stop,
 ) -> LevelStats {
+    // Nothing deep (a window, most often): nothing to set up.
+    if !pending.contains(&true) {
+        return LevelStats::default();
+    }
     let n = grid.len();
     let mut levels = Levels {
         grid,
