@@ -6,7 +6,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::dense::Factor;
-use super::kernels::{dot, wide};
+use super::kernels::{dot, flushed, wide};
 use super::level::Level;
 use super::smoother::{Keep, Part, keep_patterns};
 
@@ -90,7 +90,7 @@ impl Coarsest {
         let y = scratch;
         self.factor.solve(y);
         for (&k, &v) in self.cells.iter().zip(y.iter()) {
-            x[k] = v as f32;
+            x[k] = flushed(v as f32);
         }
     }
 }

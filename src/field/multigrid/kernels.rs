@@ -105,12 +105,28 @@ pub fn dot<A: Copy + Into<f64>, B: Copy + Into<f64>>(a: &[A], b: &[B]) -> f64 {
     (sums[0] + sums[1]) + (sums[2] + sums[3]) + tail
 }
 
-/// Scaled residual entries below this are rounded to 0 (keeps f32 away from subnormals).
+/// The cycle's values below this are rounded to 0: its scaled residual's entries, and what
+/// each smoothing pass, the coarsest solve and CG's direction make of them.
+///
+/// Why: the cycle works on values of order 1, and f32 holds 7 digits of them, so a value below
+/// 1e-30 carries nothing; but arithmetic that makes or reads a subnormal f32 (below 1.2e-38)
+/// takes a slow path in the processor, about a hundred times the time of the operation. A
+/// field decays without bound through a maze (544 decades across the shared rooms map), so the
+/// cycle's corrections decay through f32's range into the subnormals over every deep room, and
+/// smoothing kept making more of them there: the rooms map's first solve took 3.4 s where the
+/// paper's room at the same 2561² takes 0.7 s. With every value at least 1e-30 or 0, a product
+/// by a stencil's coefficients or a difference of two (a multiple of their last digit, 1e-37)
+/// stays above the subnormals.
 const FLUSH: f32 = 1e-30;
+
+/// `v`, or 0 when it is below [`FLUSH`].
+#[inline(always)]
+pub fn flushed(v: f32) -> f32 {
+    if v.abs() < FLUSH { 0.0 } else { v }
+}
 
 /// `r · scale` rounded to f32 for the cycle, 0 when too small for f32 to hold at full precision.
 #[inline(always)]
 pub fn for_cycle(r: f64, scale: f64) -> f32 {
-    let v = (r * scale) as f32;
-    if v.abs() < FLUSH { 0.0 } else { v }
+    flushed((r * scale) as f32)
 }

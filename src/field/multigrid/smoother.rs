@@ -2,7 +2,7 @@
 //! residual of a row. Every function here runs inside [`super::kernels::wide`], so each is
 //! `#[inline(always)]` (the inlining rule of `kernels.rs`).
 
-use super::kernels::Neighbourhood;
+use super::kernels::{Neighbourhood, flushed};
 use super::level::{Level, Stencil};
 
 /// Cells a short row's update computes at once: one AVX2 register of f32.
@@ -27,7 +27,7 @@ fn uniform(
     let (b, d, keep) = (&b[o..o + n], &d[o..o + n], &keep[i..i + n]);
     for l in 0..n {
         let new = d[l] * (b[l] + x.west[l] + x.east[l] + x.up[l] + x.down[l]);
-        out[l] = keep[l] * x.mid[l] + (1.0 - keep[l]) * new;
+        out[l] = flushed(keep[l] * x.mid[l] + (1.0 - keep[l]) * new);
     }
 }
 
@@ -55,7 +55,7 @@ fn coefficients(
                 + e.west[l] * x.west[l]
                 + no.mid[l] * x.up[l]
                 + no.down[l] * x.down[l]);
-        out[l] = keep[l] * x.mid[l] + (1.0 - keep[l]) * new;
+        out[l] = flushed(keep[l] * x.mid[l] + (1.0 - keep[l]) * new);
     }
 }
 
