@@ -114,9 +114,9 @@ pub fn dot<A: Copy + Into<f64>, B: Copy + Into<f64>>(a: &[A], b: &[B]) -> f64 {
 /// field decays without bound through a maze (544 decades across the shared rooms map), so the
 /// cycle's corrections decay through f32's range into the subnormals over every deep room, and
 /// smoothing kept making more of them there: the rooms map's first solve took 3.4 s where the
-/// paper's room at the same 2561² takes 0.7 s. With every value at least 1e-30 or 0, a product
-/// by a stencil's coefficients or a difference of two (a multiple of their last digit, 1e-37)
-/// stays above the subnormals.
+/// paper's room at the same 2561² takes 0.7 s (0.85 s with the flush). With every value at
+/// least 1e-30 or 0, a product by a stencil's coefficients or a difference of two (a multiple
+/// of their last digit, 1e-37) stays above the subnormals.
 const FLUSH: f32 = 1e-30;
 
 /// `v`, or 0 when it is below [`FLUSH`].

@@ -411,18 +411,23 @@ mod tests {
         }
     }
 
+    /// An `nx × ny` grid of unit cells from the origin.
+    fn unit_grid(nx: usize, ny: usize) -> Grid {
+        Grid {
+            nx,
+            ny,
+            cell: 1.0,
+            origin: [0.0, 0.0],
+        }
+    }
+
     /// A ring of unknown cells in a box (rows whose span holds a hole, rows with no unknown
     /// cell), uneven Dirichlet values around it: after each of a few iterations, the check
     /// measures the residual of the solution to the bit as a new start from it does, which
     /// the solve relies on to stop where it stopped before the check.
     #[test]
     fn the_check_measures_what_a_new_start_would_to_the_bit() {
-        let grid = Grid {
-            nx: 37,
-            ny: 29,
-            cell: 1.0,
-            origin: [0.0, 0.0],
-        };
+        let grid = unit_grid(37, 29);
         let unknown: Vec<bool> = (0..grid.len())
             .map(|k| {
                 let (i, j) = ((k % grid.nx) as f64, (k / grid.nx) as f64);
@@ -449,18 +454,13 @@ mod tests {
         }
     }
 
-    /// A corridor four cells wide and 600 long, held at 1 at one end: the field decays by
-    /// about half a decade a cell, to 1e-150 at the far end, and so do the cycle's corrections.
-    /// No value the cycle or CG's direction holds is ever a subnormal f32 (see `FLUSH`), on any
-    /// level, after any of a few iterations.
+    /// A corridor four cells wide and 600 long, held at 1 at one end: the field decays by a
+    /// quarter of a decade a cell (a factor 0.544), to 1e-158 at the far end, and so do the
+    /// cycle's corrections. No value the cycle or CG's direction holds is ever a subnormal f32
+    /// (see `FLUSH`), on any level, after any of a few iterations.
     #[test]
     fn a_decaying_field_leaves_no_subnormal_in_the_cycle() {
-        let grid = Grid {
-            nx: 600,
-            ny: 4,
-            cell: 1.0,
-            origin: [0.0, 0.0],
-        };
+        let grid = unit_grid(600, 4);
         let unknown: Vec<bool> = (0..grid.len()).map(|k| k % grid.nx > 0).collect();
         let values: Vec<f64> = (0..grid.len())
             .map(|k| if k % grid.nx == 0 { 1.0 } else { 0.0 })
