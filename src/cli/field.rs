@@ -115,14 +115,8 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
     let mut files: Vec<(PathBuf, Contents)> = Vec::new();
     if let Some(paths) = npy {
         // Each array written a few columns at a time as its file goes out (see `write_all`).
-        let arrays = [
-            FieldArray::Potential,
-            FieldArray::OneMinusPotential,
-            FieldArray::Log10OneMinusPotential,
-            FieldArray::Mask,
-        ];
         let field = &field;
-        files.extend(paths.into_iter().zip(arrays).map(|(path, array)| {
+        files.extend(paths.into_iter().zip(FieldArray::ALL).map(|(path, array)| {
             let write = move |out: &mut dyn std::io::Write| export::write_array(field, array, out);
             (path, Contents::Stream(Box::new(write)))
         }));

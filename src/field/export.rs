@@ -23,6 +23,19 @@ pub enum CellClass {
     Unreachable = 2,
 }
 
+impl CellClass {
+    /// The class of a cell that is `blocked` or not, and `reachable` from the target or not.
+    pub fn of(blocked: bool, reachable: bool) -> Self {
+        if blocked {
+            Self::Blocked
+        } else if reachable {
+            Self::Reachable
+        } else {
+            Self::Unreachable
+        }
+    }
+}
+
 /// Columns of the grid a tile of [`write_npy`] takes at once: the grid's rows are read across
 /// the tile and the array's rows (one per column) written down it, both in cache. Element by
 /// element in the array's order, each read was a row apart (8 kB at 1025²).
@@ -112,15 +125,6 @@ fn four_arrays(
     shape: &[usize],
     cells: impl Iterator<Item = usize> + Clone,
 ) -> [Vec<u8>; 4] {
-    let class = |c: usize| {
-        if blocked[c] {
-            CellClass::Blocked
-        } else if reachable[c] {
-            CellClass::Reachable
-        } else {
-            CellClass::Unreachable
-        }
-    };
     let value = |c: usize| if reachable[c] { w.value(c) } else { 0.0 };
     let log = |c: usize| {
         if reachable[c] {
@@ -135,7 +139,13 @@ fn four_arrays(
         f8(&|c| 1.0 - value(c)),
         f8(&value),
         f8(&log),
-        npy_of(shape, "|u1", cells.clone().map(|c| [class(c) as u8])),
+        npy_of(
+            shape,
+            "|u1",
+            cells
+                .clone()
+                .map(|c| [CellClass::of(blocked[c], reachable[c]) as u8]),
+        ),
     ]
 }
 
@@ -179,6 +189,16 @@ pub enum FieldArray {
     Mask,
 }
 
+impl FieldArray {
+    /// The four arrays, in the order of the paths [`npy_paths`] gives them.
+    pub const ALL: [Self; 4] = [
+        Self::Potential,
+        Self::OneMinusPotential,
+        Self::Log10OneMinusPotential,
+        Self::Mask,
+    ];
+}
+
 /// Writes `array` of `field` to `out` as an `.npy` file of shape `[nx, ny]`, a few columns at a
 /// time (a file is never held whole).
 ///
@@ -206,14 +226,7 @@ pub fn write_array(
         FieldArray::Mask => {
             let reachable = field.sampler.reachable_cells();
             write_npy(out, grid, "|u1", |k| {
-                let class = if field.blocked[k] {
-                    CellClass::Blocked
-                } else if reachable[k] {
-                    CellClass::Reachable
-                } else {
-                    CellClass::Unreachable
-                };
-                [class as u8]
+                [CellClass::of(field.blocked[k], reachable[k]) as u8]
             })
         }
     }
