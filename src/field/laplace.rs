@@ -57,22 +57,49 @@ pub enum SolveError {
 
 /// Cells reachable from `start` through free cells (4-neighbours).
 ///
-/// Breadth first: the queue holds one front of cells, a few widths of the grid (2 050 cells from
-/// the middle of an open 1025² grid), where a depth-first stack grows to a quarter of the grid
-/// (264 192 cells, 4 MB of fresh memory, every page of it faulted in).
+/// Run by run along the rows: a run of free cells is marked from wall to wall at once, and
+/// each run of free, unmarked cells above or below it is queued once, by its first cell. A
+/// cell is read a few times and no cell is divided into its row and column, where a search
+/// cell by cell looked up every cell's four neighbours (a third of the time of `nadf field`'s
+/// mask at 1025², 7 of 20 ms). The queue holds a few runs per row, not cells.
 pub fn reachable_from(grid: &Grid, blocked: &[bool], start: (usize, usize)) -> Vec<bool> {
+    let nx = grid.nx;
     let mut seen = vec![false; grid.len()];
-    let s = grid.index(start.0, start.1);
-    if blocked[s] {
+    if blocked[grid.index(start.0, start.1)] {
         return seen;
     }
-    seen[s] = true;
-    let mut front = std::collections::VecDeque::from([s]);
-    while let Some(k) = front.pop_front() {
-        for m in grid.neighbours_of(k) {
-            if !blocked[m] && !seen[m] {
-                seen[m] = true;
-                front.push_back(m);
+    let free = |k: usize, seen: &[bool]| !blocked[k] && !seen[k];
+    // Runs to fill: a free, unmarked cell of each, as (column, row).
+    let mut runs = vec![start];
+    while let Some((i, j)) = runs.pop() {
+        let row = j * nx;
+        if !free(row + i, &seen) {
+            continue;
+        }
+        // The run through (i, j): columns lo..hi.
+        let mut lo = i;
+        while lo > 0 && free(row + lo - 1, &seen) {
+            lo -= 1;
+        }
+        let mut hi = i + 1;
+        while hi < nx && free(row + hi, &seen) {
+            hi += 1;
+        }
+        seen[row + lo..row + hi].fill(true);
+        // Each run of free, unmarked cells next to it in the rows below and above.
+        let neighbours = [j.checked_sub(1), (j + 1 < grid.ny).then_some(j + 1)];
+        for b in neighbours.into_iter().flatten() {
+            let next = b * nx;
+            let mut a = lo;
+            while a < hi {
+                if free(next + a, &seen) {
+                    runs.push((a, b));
+                    while a < hi && free(next + a, &seen) {
+                        a += 1;
+                    }
+                } else {
+                    a += 1;
+                }
             }
         }
     }
@@ -218,6 +245,47 @@ mod tests {
         assert_eq!(s.w[grid.index(2, 2)], 0.0);
         assert!(s.reachable[grid.index(0, 0)]);
         assert!(s.w[grid.index(0, 0)] > 0.0);
+    }
+
+    /// The cells a search cell by cell reaches, on random masks of every density (and the
+    /// grid's edges, a start in a pocket, a start next to the edge).
+    #[test]
+    fn runs_reach_the_cells_a_search_cell_by_cell_reaches() {
+        let by_cells = |grid: &Grid, blocked: &[bool], s: (usize, usize)| {
+            let mut seen = vec![false; grid.len()];
+            let s = grid.index(s.0, s.1);
+            let mut stack = vec![s];
+            seen[s] = !blocked[s];
+            while let Some(k) = stack.pop().filter(|_| seen[s]) {
+                for m in grid.neighbours_of(k) {
+                    if !blocked[m] && !seen[m] {
+                        seen[m] = true;
+                        stack.push(m);
+                    }
+                }
+            }
+            seen
+        };
+        let mut state = 12345u64;
+        let mut random = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as f64 / (1u64 << 31) as f64
+        };
+        for density in [0.0, 0.2, 0.35, 0.45, 0.6] {
+            for (nx, ny) in [(1, 1), (1, 9), (9, 1), (37, 23)] {
+                let grid = Grid::covering([nx as f64, ny as f64], 1.0);
+                let blocked: Vec<bool> = (0..grid.len()).map(|_| random() < density).collect();
+                for s in [(0, 0), (nx / 2, ny / 2), (nx - 1, ny - 1)] {
+                    assert_eq!(
+                        reachable_from(&grid, &blocked, s),
+                        by_cells(&grid, &blocked, s),
+                        "{nx} x {ny}, density {density}, start {s:?}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
