@@ -122,6 +122,18 @@ fn substitute(l: &[f64], d: &[f64], b: usize, x: &mut [f64]) {
     }
 }
 
+/// Whether `reached` cells within `depth` steps of one cell prove that every order of them has
+/// a band wider than `max_band`: in an order of band `b`, the cells within `d` steps of a cell
+/// lie within `b · d` places of it, so there are at most `2 b d + 1` of them.
+///
+/// [`solve`] refuses a part on this bound from its first cell, within a few thousand cells of
+/// a wide one; a caller that searches the part breadth first from that cell anyway (the nested
+/// levels, finding the parts of a band) can tell by the same bound, before building anything
+/// for [`solve`], that it would refuse.
+pub fn proves_wider(reached: usize, depth: usize, max_band: usize) -> bool {
+    reached > max_band.saturating_mul(2 * depth).saturating_add(1)
+}
+
 /// A part's cells in band order.
 struct Banded {
     /// The cells in order.
@@ -137,9 +149,10 @@ struct Banded {
 /// as soon as its band is known to exceed `max_band`.
 ///
 /// A wide region is refused within a few thousand cells, not after two passes over all of it
-/// (the nested levels offer every part here first, and a room's is a hundred thousand cells):
+/// (a room's part is a hundred thousand cells):
 /// - in any order of band `b`, the cells within `d` steps of a cell lie within `b · d` places of
-///   it, so a search that finds more than `2 b d + 1` of them proves every order's band wider;
+///   it, so a search that finds more than `2 b d + 1` of them proves every order's band wider
+///   ([`proves_wider`]);
 /// - in the second search the order is the final one (reversed, which keeps the band), and
 ///   every pair of neighbours has its places once the first of them is visited, so the band is
 ///   known exactly as the search goes.
@@ -184,7 +197,7 @@ fn reverse_cuthill_mckee(neighbours: &[Neighbours], max_band: usize) -> Option<B
                 // Every cell within `depth` steps is visited: `order` holds those within
                 // `depth + 1`.
                 (depth, reached) = (depth + 1, order.len());
-                if reached > max_band.saturating_mul(2 * depth).saturating_add(1) {
+                if proves_wider(reached, depth, max_band) {
                     return None;
                 }
             }

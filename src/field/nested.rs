@@ -171,6 +171,17 @@ pub fn deep_cells(grid: &Grid, unknown: &[bool], w: &[f64], depth: f64) -> Vec<b
 /// (below it, the threads would cost more than they save; the results are the same either way).
 pub const PARALLEL_CELLS: usize = 20_000;
 
+/// One connected part of a band.
+struct Part {
+    /// Its cells, breadth first from the first (their slots).
+    cells: Vec<usize>,
+    /// Whether the search that found it proved it too wide for a direct solve
+    /// ([`banded::proves_wider`] from its first cell, the bound [`banded::solve`] refuses it
+    /// on): it goes to multigrid without building the direct solve's system first, a pass
+    /// over all its cells (5 ms of the 1024² room's 147 k-cell part).
+    wide: bool,
+}
+
 /// One part of a band, solved: its cells' values (in the part's order) at the scale `2^scale`.
 struct Solved {
     values: Vec<f64>,
@@ -243,23 +254,7 @@ pub fn solve_levels(
         return LevelStats::default();
     }
     let n = grid.len();
-    let mut levels = Levels {
-        grid,
-        w,
-        tolerance,
-        frontier: Vec::new(),
-        band: vec![0; n],
-        dist: vec![0; n],
-        part: vec![0; n],
-        seen: vec![0; n],
-        slot: vec![0; n],
-        stamp: 0,
-        level: 0,
-        core_steps: CORE_STEPS,
-        settled: false,
-        stats: LevelStats::default(),
-        pending,
-    };
+    let mut levels = Levels::new(grid, pending, w, tolerance);
     // The first frontier: accepted cells (the target among them) next to pending ones.
     for k in 0..n {
         if levels.accepted(k) && levels.neighbours(k).any(|m| levels.pending[m]) {
@@ -296,7 +291,29 @@ pub fn solve_levels(
     levels.stats
 }
 
-impl Levels<'_> {
+impl<'a> Levels<'a> {
+    /// No level run yet, no frontier, `pending` as given.
+    fn new(grid: &'a Grid, pending: Vec<bool>, w: &'a mut ScaledW, tolerance: f64) -> Self {
+        let n = grid.len();
+        Self {
+            grid,
+            w,
+            tolerance,
+            frontier: Vec::new(),
+            band: vec![0; n],
+            dist: vec![0; n],
+            part: vec![0; n],
+            seen: vec![0; n],
+            slot: vec![0; n],
+            stamp: 0,
+            level: 0,
+            core_steps: CORE_STEPS,
+            settled: false,
+            stats: LevelStats::default(),
+            pending,
+        }
+    }
+
     /// The 4-neighbours of cell `k`, as indices.
     fn neighbours(&self, k: usize) -> impl Iterator<Item = usize> + use<> {
         self.grid.neighbours_of(k)
@@ -356,8 +373,8 @@ impl Levels<'_> {
         // The parts are disjoint and each reads only the accepted cells around it, so they are
         // solved independently (in parallel when there is enough work) with the same results.
         let this = &*self;
-        let solve = |(index, cells): (usize, &Vec<usize>)| this.solve_part(index as u32, cells);
-        let work: usize = parts.iter().map(Vec::len).sum();
+        let solve = |(index, part): (usize, &Part)| this.solve_part(index as u32, part);
+        let work: usize = parts.iter().map(|p| p.cells.len()).sum();
         let solved: Vec<Solved> = if parts.len() > 1 && work >= PARALLEL_CELLS {
             parts.par_iter().enumerate().map(solve).collect()
         } else {
@@ -365,7 +382,7 @@ impl Levels<'_> {
         };
         let mut accepted = Vec::new();
         let mut cut_limited = false;
-        for (cells, solved) in parts.iter().zip(solved) {
+        for (Part { cells, .. }, solved) in parts.iter().zip(solved) {
             self.stats.solves += 1;
             self.stats.cells_solved += cells.len();
             self.stats.iterations += solved.iterations;
@@ -477,8 +494,8 @@ impl Levels<'_> {
         band
     }
 
-    /// The connected parts of the band (4-neighbours), each a list of cells.
-    fn parts(&mut self, band: &[usize]) -> Vec<Vec<usize>> {
+    /// The connected parts of the band (4-neighbours).
+    fn parts(&mut self, band: &[usize]) -> Vec<Part> {
         self.stamp += 1;
         let stamp = self.stamp;
         let mut parts = Vec::new();
@@ -490,6 +507,8 @@ impl Levels<'_> {
             let index = parts.len() as u32;
             let mut cells = vec![start];
             let mut head = 0;
+            // The cells within `depth` steps of `start` are `cells[..reached]`.
+            let (mut depth, mut reached, mut wide) = (0, 1, false);
             while head < cells.len() {
                 let k = cells[head];
                 self.slot[k] = head as u32;
@@ -501,17 +520,21 @@ impl Levels<'_> {
                         cells.push(m);
                     }
                 }
+                if head == reached {
+                    (depth, reached) = (depth + 1, cells.len());
+                    wide |= banded::proves_wider(reached, depth, MAX_BAND);
+                }
             }
-            parts.push(cells);
+            parts.push(Part { cells, wide });
         }
         parts
     }
 
-    /// Solves part `index` of the band (its `cells`, in the order of their slots), with the
+    /// Solves part `index` of the band (its cells are in the order of their slots), with the
     /// accepted cells around it as Dirichlet values and 0 at the cut, at the scale `2^e` of its
     /// largest accepted neighbour: directly when it is narrow, else by multigrid on its bounding
     /// box. Reads only `self`.
-    fn solve_part(&self, index: u32, cells: &[usize]) -> Solved {
+    fn solve_part(&self, index: u32, Part { cells, wide }: &Part) -> Solved {
         let scale = cells
             .iter()
             .flat_map(|&k| self.neighbours(k))
@@ -519,7 +542,12 @@ impl Levels<'_> {
             .map(|m| self.w.exponent[m] + exponent_of(self.w.mantissa[m]))
             .max()
             .unwrap_or(0);
-        match self.solve_narrow(index, cells, scale) {
+        let narrow = if *wide {
+            None
+        } else {
+            self.solve_narrow(index, cells, scale)
+        };
+        match narrow {
             Some(values) => Solved {
                 values,
                 scale,
@@ -777,6 +805,40 @@ mod tests {
 
     /// The field of the serpentine from the target `(1, 1)`, its nested levels stopping as
     /// `stop` allows.
+    /// A part that the search for the band's parts proves too wide is one the direct solve
+    /// would refuse (so skipping its try changes nothing), and a corridor is still offered to
+    /// it and solved: a room 200 cells square and a corridor 3 cells wide, in one band. (From
+    /// the room's corner, `(d + 1)(d + 2) / 2` cells lie within `d` steps: more than the
+    /// `2 · 48 d + 1` a band of 48 allows once `d` passes 190.)
+    #[test]
+    fn a_part_proved_wide_is_one_the_direct_solve_refuses() {
+        let grid = Grid::covering([220.0, 220.0], 1.0);
+        let room = |i: usize, j: usize| (10..210).contains(&i) && (5..205).contains(&j);
+        let corridor = |_: usize, j: usize| (210..213).contains(&j);
+        let band: Vec<usize> = (0..grid.ny)
+            .flat_map(|j| (0..grid.nx).map(move |i| (i, j)))
+            .filter(|&(i, j)| room(i, j) || corridor(i, j))
+            .map(|(i, j)| grid.index(i, j))
+            .collect();
+        let mut w = ScaledW::from_plain(vec![0.0; grid.len()]);
+        let mut levels = Levels::new(&grid, vec![true; grid.len()], &mut w, 1e-12);
+        levels.level = 1;
+        for &k in &band {
+            levels.band[k] = 1;
+        }
+        let parts = levels.parts(&band);
+        assert_eq!(parts.len(), 2);
+        for (index, part) in parts.iter().enumerate() {
+            let direct = levels.solve_narrow(index as u32, &part.cells, 0);
+            if part.cells.len() == 200 * 200 {
+                assert!(part.wide && direct.is_none());
+            } else {
+                assert_eq!(part.cells.len(), 220 * 3);
+                assert!(!part.wide && direct.is_some());
+            }
+        }
+    }
+
     fn levels_with(grid: &Grid, reachable: &[bool], stop: &Stop) -> (ScaledW, LevelStats) {
         let target = [grid.index(1, 1)];
         let s = crate::field::harmonic::solve_w_for(grid, (reachable, &target), 1e-12, None, stop);
