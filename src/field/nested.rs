@@ -371,18 +371,24 @@ impl<'a> Levels<'a> {
         let band = self.band_cells(lowest);
         let parts = self.parts(&band);
         // The parts are disjoint and each reads only the accepted cells around it, so they are
-        // solved independently (in parallel when there is enough work) with the same results.
+        // solved, and their resolved cells found, independently (in parallel when there is
+        // enough work) with the same results.
         let this = &*self;
-        let solve = |(index, part): (usize, &Part)| this.solve_part(index as u32, part);
-        let work: usize = parts.iter().map(|p| p.cells.len()).sum();
-        let solved: Vec<Solved> = if parts.len() > 1 && work >= PARALLEL_CELLS {
-            parts.par_iter().enumerate().map(solve).collect()
-        } else {
-            parts.iter().enumerate().map(solve).collect()
+        let solve = |(index, part): (usize, &Part)| {
+            let solved = this.solve_part(index as u32, part);
+            let resolved = this.resolved(&part.cells, &solved, lowest);
+            (solved, resolved)
         };
+        let work: usize = parts.iter().map(|p| p.cells.len()).sum();
+        let results: Vec<(Solved, (Vec<usize>, bool))> =
+            if parts.len() > 1 && work >= PARALLEL_CELLS {
+                parts.par_iter().enumerate().map(solve).collect()
+            } else {
+                parts.iter().enumerate().map(solve).collect()
+            };
         let mut accepted = Vec::new();
         let mut cut_limited = false;
-        for (Part { cells, .. }, solved) in parts.iter().zip(solved) {
+        for (Part { cells, .. }, (solved, (resolved, limited))) in parts.iter().zip(results) {
             self.stats.solves += 1;
             self.stats.cells_solved += cells.len();
             self.stats.iterations += solved.iterations;
@@ -392,7 +398,6 @@ impl<'a> Levels<'a> {
                 self.w.mantissa[k] = v;
                 self.w.exponent[k] = solved.scale;
             }
-            let (resolved, limited) = self.resolved(cells, solved.scale, lowest);
             accepted.extend(resolved);
             cut_limited |= limited;
         }
@@ -617,63 +622,57 @@ impl<'a> Levels<'a> {
         }
     }
 
-    /// The cells of a solved part that are resolved (at least `τ` of the scale `2^e`), more
-    /// than [`MARGIN`] steps from the cut, and at least [`GAP`] times the values near the cut
-    /// and the level's `lowest` source (`log2 W`); and whether the cut kept resolved cells out.
-    fn resolved(&mut self, cells: &[usize], e: i32, lowest: f64) -> (Vec<usize>, bool) {
-        // Steps from the cut, up to MARGIN: `seen == stamp` marks the cells near it.
-        self.stamp += 1;
-        let near = self.stamp;
-        let mut layer: Vec<usize> = cells
-            .iter()
-            .copied()
-            .filter(|&k| {
-                self.neighbours(k)
+    /// The cells of a solved part that are resolved (at least `τ` of its scale), more than
+    /// [`MARGIN`] steps from the cut, and at least [`GAP`] times the values near the cut and the
+    /// level's `lowest` source (`log2 W`); and whether the cut kept resolved cells out. Reads
+    /// only `self` and the part (its cells by their slots, its solved values at their scale),
+    /// so each part's are found on the thread that solved it.
+    fn resolved(&self, cells: &[usize], solved: &Solved, lowest: f64) -> (Vec<usize>, bool) {
+        let values = &solved.values;
+        // Steps from the cut, up to MARGIN, by slot. A band cell next to one of the part's
+        // cells is in the part (the parts are the band's connected parts).
+        let mut near_cut = vec![false; cells.len()];
+        let mut layer: Vec<usize> = (0..cells.len())
+            .filter(|&s| {
+                self.neighbours(cells[s])
                     .any(|m| self.pending[m] && !self.in_band(m))
             })
             .collect();
-        for &k in &layer {
-            self.seen[k] = near;
+        for &s in &layer {
+            near_cut[s] = true;
         }
         for _ in 0..MARGIN {
             let mut next = Vec::new();
-            for &k in &layer {
-                for m in self.neighbours(k) {
-                    if self.in_band(m) && self.seen[m] != near {
-                        self.seen[m] = near;
-                        next.push(m);
+            for &s in &layer {
+                for m in self.neighbours(cells[s]) {
+                    let t = self.slot[m] as usize;
+                    if self.in_band(m) && !near_cut[t] {
+                        near_cut[t] = true;
+                        next.push(t);
                     }
                 }
             }
             layer = next;
         }
-        let near_cut: Vec<bool> = cells.iter().map(|&k| self.seen[k] == near).collect();
         // The part's values near the cut: a cell far above them is little changed by it.
-        let at_cut = cells
+        let at_cut = values
             .iter()
             .zip(&near_cut)
             .filter(|&(_, near)| *near)
-            .map(|(&k, _)| self.w.at_scale(k, e))
+            .map(|(&v, _)| v)
             .fold(
-                ldexp(1.0, (lowest.floor() as i32).saturating_sub(e)),
+                ldexp(1.0, (lowest.floor() as i32).saturating_sub(solved.scale)),
                 f64::max,
             );
         // Resolved: the cells at least τ of the scale. (No REACH rule here, unlike the first
         // solve's: a weak cell a few steps from a strong one is small because `W` decays
         // along a corridor as often as because a wall is near, and the next level, at a
         // smaller scale, resolves it anyway.)
-        self.stamp += 1;
-        let resolved = self.stamp;
-        for &k in cells {
-            if self.w.at_scale(k, e) >= DEPTH_STEP {
-                self.seen[k] = resolved;
-            }
-        }
         let mut cut_limited = false;
         let mut accepted = Vec::new();
-        for (&k, near_cut) in cells.iter().zip(near_cut) {
-            if self.seen[k] == resolved {
-                if near_cut || self.w.at_scale(k, e) < GAP * at_cut {
+        for ((&k, &v), &near_cut) in cells.iter().zip(values).zip(&near_cut) {
+            if v >= DEPTH_STEP {
+                if near_cut || v < GAP * at_cut {
                     cut_limited = true;
                 } else {
                     accepted.push(k);
