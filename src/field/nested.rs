@@ -204,13 +204,14 @@ struct Levels<'a> {
     frontier: Vec<usize>,
     /// `band[k] == level` when cell `k` is in this level's band.
     band: Vec<u32>,
-    /// Steps from the accepted cells (in the band).
+    /// Steps from the accepted cells (in the band); beyond it, the tail search's marks (see
+    /// [`TailSearch`]).
     dist: Vec<u32>,
     /// Index of the part of the band a cell is in (in the band).
     part: Vec<u32>,
-    /// Scratch marks for the per-part passes: `seen[k] == stamp`.
+    /// The search for the band's parts' marks: `seen[k] == stamp` (see [`PartSearch`]).
     seen: Vec<u32>,
-    /// A band cell's index in its part (set with `part` by `parts`).
+    /// A band cell's index in its part (set with `part` by [`PartSearch`]).
     slot: Vec<u32>,
     stamp: u32,
     level: u32,
@@ -368,8 +369,22 @@ impl<'a> Levels<'a> {
         // accepts nothing below GAP times that: cells are accepted in order of decreasing `W`,
         // a few decades per level, so a cut never lies where a larger `W` still flows in.
         let lowest = top + LEVEL_RANGE.log2();
-        let band = self.band_cells(lowest);
-        let parts = self.parts(&band);
+        let (mut band, margin) = self.band_cells(lowest);
+        // The band's parts, and meanwhile whether it takes the tail: most levels' tail does not
+        // fit, and the parts found without it stand.
+        let (parts_search, tail_search) = self.searches();
+        let (mut parts, tail) = join_if(
+            band.len() >= PARALLEL_CELLS,
+            || parts_search.run(&band),
+            || tail_search.run(margin, band.len()),
+        );
+        if let Some(tail) = tail {
+            for &m in &tail {
+                self.band[m] = self.level;
+            }
+            band.extend_from_slice(&tail);
+            parts = self.searches().0.run(&band);
+        }
         // The parts are disjoint and each reads only the accepted cells around it, so they are
         // solved, and their resolved cells found, independently (in parallel when there is
         // enough work) with the same results.
@@ -422,8 +437,9 @@ impl<'a> Levels<'a> {
         accepted
     }
 
-    /// This level's band: its core (breadth-first from the frontier) and its margin.
-    fn band_cells(&mut self, lowest: f64) -> Vec<usize> {
+    /// This level's band: its core (breadth-first from the frontier) and its margin; and the
+    /// margin's last layer (where a tail would start, see [`TailSearch`]).
+    fn band_cells(&mut self, lowest: f64) -> (Vec<usize>, Vec<usize>) {
         let level = self.level;
         let mut band = Vec::new();
         for i in 0..self.frontier.len() {
@@ -472,67 +488,30 @@ impl<'a> Levels<'a> {
             band.extend_from_slice(&next);
             layer = next;
         }
-        // The tail: when every pending cell left beyond the margin fits in as many cells again
-        // as the band has, the band takes them all and has no cut (a room's deep corner); a
-        // maze's rest does not fit, and is left for the next levels.
-        let budget = band.len();
-        let mut tail = Vec::new();
-        let mut head = 0;
-        let mut frontier = layer;
-        while let Some(&k) = frontier.get(head) {
-            head += 1;
-            for m in self.neighbours(k) {
-                if self.pending[m] && self.band[m] != level {
-                    self.band[m] = level;
-                    tail.push(m);
-                    frontier.push(m);
-                }
-            }
-            if tail.len() > budget {
-                for &m in &tail {
-                    self.band[m] = 0;
-                }
-                return band;
-            }
-        }
-        band.extend_from_slice(&tail);
-        band
+        (band, layer)
     }
 
-    /// The connected parts of the band (4-neighbours).
-    fn parts(&mut self, band: &[usize]) -> Vec<Part> {
+    /// The searches for this level's band's parts and for its tail, each with the marks it
+    /// reads and writes (apart, so that they can run at once).
+    fn searches(&mut self) -> (PartSearch<'_>, TailSearch<'_>) {
         self.stamp += 1;
-        let stamp = self.stamp;
-        let mut parts = Vec::new();
-        for &start in band {
-            if self.seen[start] == stamp {
-                continue;
-            }
-            self.seen[start] = stamp;
-            let index = parts.len() as u32;
-            let mut cells = vec![start];
-            let mut head = 0;
-            // The cells within `depth` steps of `start` are `cells[..reached]`.
-            let (mut depth, mut reached, mut wide) = (0, 1, false);
-            while head < cells.len() {
-                let k = cells[head];
-                self.slot[k] = head as u32;
-                head += 1;
-                self.part[k] = index;
-                for m in self.neighbours(k) {
-                    if self.in_band(m) && self.seen[m] != stamp {
-                        self.seen[m] = stamp;
-                        cells.push(m);
-                    }
-                }
-                if head == reached {
-                    (depth, reached) = (depth + 1, cells.len());
-                    wide |= banded::proves_wider(reached, depth, MAX_BAND);
-                }
-            }
-            parts.push(Part { cells, wide });
-        }
-        parts
+        let parts = PartSearch {
+            grid: self.grid,
+            band: &self.band,
+            level: self.level,
+            seen: &mut self.seen,
+            slot: &mut self.slot,
+            part: &mut self.part,
+            stamp: self.stamp,
+        };
+        let tail = TailSearch {
+            grid: self.grid,
+            pending: &self.pending,
+            band: &self.band,
+            level: self.level,
+            visited: &mut self.dist,
+        };
+        (parts, tail)
     }
 
     /// Solves part `index` of the band (its cells are in the order of their slots), with the
@@ -683,6 +662,106 @@ impl<'a> Levels<'a> {
     }
 }
 
+/// The search for the connected parts (4-neighbours) of a band (see [`Levels`] for the marks).
+struct PartSearch<'a> {
+    grid: &'a Grid,
+    band: &'a [u32],
+    level: u32,
+    seen: &'a mut [u32],
+    slot: &'a mut [u32],
+    part: &'a mut [u32],
+    /// This search's stamp in `seen`.
+    stamp: u32,
+}
+
+impl PartSearch<'_> {
+    /// The parts of `band` (the cells whose mark is `level`), setting each cell's part and slot.
+    fn run(self, band: &[usize]) -> Vec<Part> {
+        let (grid, stamp) = (self.grid, self.stamp);
+        let mut parts = Vec::new();
+        for &start in band {
+            if self.seen[start] == stamp {
+                continue;
+            }
+            self.seen[start] = stamp;
+            let index = parts.len() as u32;
+            let mut cells = vec![start];
+            let mut head = 0;
+            // The cells within `depth` steps of `start` are `cells[..reached]`.
+            let (mut depth, mut reached, mut wide) = (0, 1, false);
+            while head < cells.len() {
+                let k = cells[head];
+                self.slot[k] = head as u32;
+                head += 1;
+                self.part[k] = index;
+                for m in grid.neighbours_of(k) {
+                    if self.band[m] == self.level && self.seen[m] != stamp {
+                        self.seen[m] = stamp;
+                        cells.push(m);
+                    }
+                }
+                if head == reached {
+                    (depth, reached) = (depth + 1, cells.len());
+                    wide |= banded::proves_wider(reached, depth, MAX_BAND);
+                }
+            }
+            parts.push(Part { cells, wide });
+        }
+        parts
+    }
+}
+
+/// The search for a band's tail: when every pending cell left beyond the margin fits in as
+/// many cells again as the band has, the band takes them all and has no cut (a room's deep
+/// corner); a maze's rest does not fit, and is left for the next levels. It marks the cells it
+/// visits in `visited` (the steps `Levels::dist`, which no pass reads outside the band), not in
+/// the band's marks, so the band's parts can be found meanwhile.
+struct TailSearch<'a> {
+    grid: &'a Grid,
+    pending: &'a [bool],
+    band: &'a [u32],
+    level: u32,
+    visited: &'a mut [u32],
+}
+
+impl TailSearch<'_> {
+    /// The tail beyond the margin's last layer `margin`, if it has at most `budget` cells.
+    fn run(self, margin: Vec<usize>, budget: usize) -> Option<Vec<usize>> {
+        // Never a step count (each below the number of cells), and this level's own.
+        let mark = u32::MAX - self.level;
+        let mut tail = Vec::new();
+        let mut head = 0;
+        let mut frontier = margin;
+        while let Some(&k) = frontier.get(head) {
+            head += 1;
+            for m in self.grid.neighbours_of(k) {
+                if self.pending[m] && self.band[m] != self.level && self.visited[m] != mark {
+                    self.visited[m] = mark;
+                    tail.push(m);
+                    frontier.push(m);
+                }
+            }
+            if tail.len() > budget {
+                return None;
+            }
+        }
+        Some(tail)
+    }
+}
+
+/// `a` and `b`, at once when `parallel` (see `rayon::join`), else one after the other.
+fn join_if<A: Send, B: Send>(
+    parallel: bool,
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    if parallel {
+        rayon::join(a, b)
+    } else {
+        (a(), b())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -825,7 +904,7 @@ mod tests {
         for &k in &band {
             levels.band[k] = 1;
         }
-        let parts = levels.parts(&band);
+        let parts = levels.searches().0.run(&band);
         assert_eq!(parts.len(), 2);
         for (index, part) in parts.iter().enumerate() {
             let direct = levels.solve_narrow(index as u32, &part.cells, 0);
