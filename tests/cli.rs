@@ -472,6 +472,28 @@ fn w_classes(mask: &[u8], w: &[u8]) -> (usize, usize, usize) {
     (target, inside, other)
 }
 
+/// A reader that goes away (`nadf field … | head -1`) is not the command's failure: no panic,
+/// the files written, exit status 0.
+#[test]
+fn a_closed_standard_output_is_no_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = world_path("room-two-dividers.toml");
+    let mut child = Command::new(nadf_bin())
+        .current_dir(dir.path())
+        .args(["field", world.to_str().unwrap(), "--npy", "room.npy"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Closed before the field is solved, so every line the command says meets a closed pipe.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(dir.path().join("room.mask.npy").is_file());
+}
+
 #[test]
 fn field_exports_numpy_arrays_and_a_picture() {
     let dir = tempfile::tempdir().unwrap();

@@ -53,19 +53,19 @@ pub fn check(args: &CheckArgs) -> Result<(), Failure> {
                     bodies += &format!(", {n} {kind}(s)");
                 }
             }
-            println!(
+            say!(
                 "{}: ok ({}, {bodies}, {} wall(s))",
                 path.display(),
                 world.name(),
                 world.walls.len()
             );
             for warning in &narrow {
-                println!("{}: warning: {warning}", path.display());
+                say!("{}: warning: {warning}", path.display());
             }
             // A lidar agent is not refused (it must find out online), but the user is told.
             for agent in world.agents.iter().filter(|a| a.has_lidar()) {
                 if let Err(e) = FreeSpace::of(&world, agent) {
-                    println!(
+                    say!(
                         "{}: note: with full knowledge of the walls, {e}; `{}` plans on what its lidar sees and will find out online",
                         path.display(),
                         agent.name

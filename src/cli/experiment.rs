@@ -78,7 +78,7 @@ pub fn experiment(args: &ExperimentArgs, console: &Console) -> Result<(), Failur
         )));
     }
     let rate = done.ran as f64 / done.wall_time.as_secs_f64().max(1e-9);
-    println!(
+    say!(
         "{} runs on {} thread(s) in {:.2} s ({rate:.2} runs/s){}",
         done.ran,
         done.threads,
@@ -90,7 +90,7 @@ pub fn experiment(args: &ExperimentArgs, console: &Console) -> Result<(), Failur
         }
     );
     if shard != Shard::WHOLE {
-        println!(
+        say!(
             "shard {shard} complete in {}; `nadf merge {} --out DIR` combines the shards",
             dir.display(),
             out.display()
@@ -100,9 +100,9 @@ pub fn experiment(args: &ExperimentArgs, console: &Console) -> Result<(), Failur
     let manifest = exp.manifest(shard, true);
     let (files, groups) =
         write_results(&dir, &manifest, &done.records).map_err(|e| bad_input(path, e))?;
-    print!("{}", crate::experiment::results::groups_table(&groups));
+    super::say_block(&crate::experiment::results::groups_table(&groups));
     for f in files {
-        println!("wrote {}", f.display());
+        say!("wrote {}", f.display());
     }
     Ok(())
 }
@@ -112,16 +112,15 @@ pub fn experiment(args: &ExperimentArgs, console: &Console) -> Result<(), Failur
 pub fn merge(args: &MergeArgs) -> Result<(), Failure> {
     let merged = crate::experiment::batch::merge(&args.dirs, &args.out)
         .map_err(|e| Failure::BadInput(format!("error: nadf merge: {e}")))?;
-    println!(
+    say!(
         "merged {} shard(s) of experiment `{}`: {} runs",
-        merged.shards, merged.experiment, merged.runs
+        merged.shards,
+        merged.experiment,
+        merged.runs
     );
-    print!(
-        "{}",
-        crate::experiment::results::groups_table(&merged.groups)
-    );
+    super::say_block(&crate::experiment::results::groups_table(&merged.groups));
     for f in merged.files {
-        println!("wrote {}", f.display());
+        say!("wrote {}", f.display());
     }
     Ok(())
 }

@@ -85,7 +85,7 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
     let field = HarmonicField::solve(&world, agent).map_err(|e| bad_input(path, e))?;
     let grid = field.grid();
     let counts = field.counts();
-    println!(
+    say!(
         "field of {}: {} x {} cells of {} m ({} reachable, {} blocked, {} unreachable)",
         agent.name,
         grid.nx,
@@ -95,7 +95,7 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         counts.blocked,
         counts.unreachable
     );
-    println!(
+    say!(
         "solve: {:.1} ms, {} solve(s), {} CG iterations, relative residual {:.1e}",
         field.solve_time.as_secs_f64() * 1e3,
         field.solves,
@@ -103,12 +103,14 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         field.relative_residual
     );
     if field.nested.levels > 0 {
-        println!(
+        say!(
             "nested: {} level(s), {} cells solved in {} part(s)",
-            field.nested.levels, field.nested.cells_solved, field.nested.solves
+            field.nested.levels,
+            field.nested.cells_solved,
+            field.nested.solves
         );
     }
-    println!(
+    say!(
         "1 - V at the start: {}",
         scientific(field.log10_one_minus_potential(agent.start))
     );
@@ -146,7 +148,7 @@ fn pose_field(
     let (grid, d) = (field.grid(), field.dims());
     let reachable = field.reachable.iter().filter(|r| **r).count();
     let blocked = field.mask.blocked.iter().filter(|b| **b).count();
-    println!(
+    say!(
         "field of {}: {} x {} cells of {} m x {} headings ({reachable} reachable, {blocked} blocked, {} unreachable); ρ = {rho:.4} m",
         agent.name,
         grid.nx,
@@ -155,7 +157,7 @@ fn pose_field(
         d.nt,
         d.len() - reachable - blocked
     );
-    println!(
+    say!(
         "mask: {:.1} ms (margin {:.4} m); solve: {:.1} ms, {} solve(s), {} CG iterations, relative residual {:.1e}",
         field.mask_time.as_secs_f64() * 1e3,
         field.mask.margin,
@@ -165,7 +167,7 @@ fn pose_field(
         field.relative_residual
     );
     let start = [agent.start[0], agent.start[1], agent.heading];
-    println!(
+    say!(
         "1 - V at the start: {}",
         scientific(field.log10_one_minus_potential(start))
     );
@@ -202,14 +204,14 @@ fn arm_field(
         .collect();
     let reachable = field.reachable.iter().filter(|r| **r).count();
     let blocked = field.mask.blocked.iter().filter(|b| **b).count();
-    println!(
+    say!(
         "field of {}: {} joint cells ({reachable} reachable, {blocked} blocked, {} unreachable, {} in the target set)",
         arm.name,
         cells.join(" x "),
         field.reachable.len() - reachable - blocked,
         field.target_cells.len()
     );
-    println!(
+    say!(
         "mask: {:.1} ms; solve: {:.1} ms, {} solve(s), {} CG iterations, relative residual {:.1e}",
         mask_time.as_secs_f64() * 1e3,
         field.solve_time.as_secs_f64() * 1e3,
@@ -217,7 +219,7 @@ fn arm_field(
         field.iterations,
         field.relative_residual
     );
-    println!(
+    say!(
         "1 - V at the start: {}",
         scientific(field.log10_one_minus_potential(&arm.start))
     );

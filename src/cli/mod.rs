@@ -10,6 +10,14 @@
 //! | 2 | bad input: a world file, an override, an output that cannot be written, or an intractable task |
 //! | 130 | interrupted with Ctrl-C |
 
+/// `println!` for what a command reports, without its panic when standard output is closed
+/// (`nadf field … | head -3`): see [`say`].
+macro_rules! say {
+    ($($arg:tt)*) => {
+        $crate::cli::say(format_args!($($arg)*))
+    };
+}
+
 mod check;
 mod experiment;
 mod field;
@@ -33,6 +41,24 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::output::{Contents, write_contents};
 use crate::world::{Override, World, WorldFile};
+
+/// Writes `text` and a newline to standard output. A reader that has gone (`nadf field … |
+/// head -3`) is not the run's failure: its files are still written and its exit status stands,
+/// so a line that cannot be written is dropped, where `println!` would panic.
+///
+/// ```
+/// nadf::cli::say(format_args!("solve: {:.1} ms", 12.25));
+/// ```
+pub fn say(text: std::fmt::Arguments) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stdout().lock(), "{text}");
+}
+
+/// [`say`] for a block of lines that ends with its own newline (a table).
+pub fn say_block(block: &str) {
+    use std::io::Write;
+    let _ = std::io::stdout().lock().write_all(block.as_bytes());
+}
 
 /// Why a command did not succeed.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -172,7 +198,7 @@ fn write_all<'a, C: Into<Contents<'a>>>(
     });
     for ((file, _), result) in files.iter().zip(written) {
         result.map_err(|e| bad_input(world, e))?;
-        println!("wrote {}", file.display());
+        say!("wrote {}", file.display());
     }
     Ok(())
 }

@@ -64,7 +64,7 @@ pub fn reproduce(args: &ReproduceArgs, console: &Console) -> Result<(), Failure>
     std::fs::create_dir_all(dir)
         .map_err(|e| bad(&format!("cannot create {}: {e}", dir.display())))?;
     write_all(dir, files)?;
-    println!(
+    say!(
         "{} claims. {} {} runs in {:.1} s",
         checked.len(),
         report::counts_line(&report),

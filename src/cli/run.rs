@@ -67,18 +67,18 @@ pub fn run(args: &RunArgs, console: &Console) -> Result<(), Failure> {
         interrupt: Some(console.interrupt.clone()),
     };
     let report = crate::run::run(&world, &options).map_err(|e| bad_input(path, e))?;
-    print!("{}", report.table());
+    super::say_block(&report.table());
     let wall = report.wall_time.as_secs_f64();
     match &report.recording {
-        Some(rrd) => println!(
+        Some(rrd) => say!(
             "wall time {wall:.2} s; recording: {} (open it with `rerun {}`)",
             rrd.display(),
             rrd.display()
         ),
-        None => println!("wall time {wall:.2} s; no recording"),
+        None => say!("wall time {wall:.2} s; no recording"),
     }
     if let Some(streamed) = streamed {
-        println!("{streamed}");
+        say!("{streamed}");
     }
     if let Some(t) = report.interrupted_at {
         return Err(Failure::Interrupted(format!(

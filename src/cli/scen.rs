@@ -69,11 +69,11 @@ pub fn scen(args: &ScenArgs, console: &Console) -> Result<(), Failure> {
     )?;
     for o in outcomes.iter().filter(|o| o.summary.is_err()) {
         if let Err(why) = &o.summary {
-            println!("skipped line {}: {why}", o.scenario.line);
+            say!("skipped line {}: {why}", o.scenario.line);
         }
     }
     let t = scen::totals(&outcomes);
-    println!(
+    say!(
         "{} scenario(s) run, {} skipped: {} reached ({:.0} %), {} contact(s), mean path / optimal {}",
         t.run,
         t.skipped,

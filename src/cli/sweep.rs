@@ -71,7 +71,7 @@ pub fn sweep(args: &SweepArgs, console: &Console) -> Result<(), Failure> {
             (dir.join("sweep.png"), picture),
         ],
     )?;
-    println!(
+    say!(
         "{} runs on {} thread(s) in {:.2} s",
         done.runs.len(),
         done.threads,
