@@ -254,9 +254,12 @@ mod tests {
         let by_cells = |grid: &Grid, blocked: &[bool], s: (usize, usize)| {
             let mut seen = vec![false; grid.len()];
             let s = grid.index(s.0, s.1);
-            let mut stack = vec![s];
-            seen[s] = !blocked[s];
-            while let Some(k) = stack.pop().filter(|_| seen[s]) {
+            let mut stack = Vec::new();
+            if !blocked[s] {
+                seen[s] = true;
+                stack.push(s);
+            }
+            while let Some(k) = stack.pop() {
                 for m in grid.neighbours_of(k) {
                     if !blocked[m] && !seen[m] {
                         seen[m] = true;

@@ -62,6 +62,21 @@ pub use streamline::Streamline;
 pub use window::{Reach, Window};
 pub use yielding::{CLEAR_OF_WAY, IN_THE_WAY, STEP_ASIDE, WAY_AHEAD, Way};
 
+/// `a` and `b`, at once when `parallel` (see `rayon::join`), else one after the other: for
+/// work that pays for handing half of it to another thread only when it is large. The results
+/// are the same either way.
+fn join_if<A: Send, B: Send>(
+    parallel: bool,
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    if parallel {
+        rayon::join(a, b)
+    } else {
+        (a(), b())
+    }
+}
+
 /// The solver's internals, public for the benchmarks only: not part of the crate's API.
 #[doc(hidden)]
 pub mod solvers {

@@ -37,6 +37,7 @@ use rayon::prelude::*;
 
 use super::banded;
 use super::grid::Grid;
+use super::join_if;
 use super::multigrid;
 use super::scaled::{ScaledW, exponent_of, ldexp};
 
@@ -649,9 +650,9 @@ impl<'a> Levels<'a> {
         // smaller scale, resolves it anyway.)
         let mut cut_limited = false;
         let mut accepted = Vec::new();
-        for ((&k, &v), &near_cut) in cells.iter().zip(values).zip(&near_cut) {
+        for ((&k, &v), &near) in cells.iter().zip(values).zip(&near_cut) {
             if v >= DEPTH_STEP {
-                if near_cut || v < GAP * at_cut {
+                if near || v < GAP * at_cut {
                     cut_limited = true;
                 } else {
                     accepted.push(k);
@@ -746,19 +747,6 @@ impl TailSearch<'_> {
             }
         }
         Some(tail)
-    }
-}
-
-/// `a` and `b`, at once when `parallel` (see `rayon::join`), else one after the other.
-fn join_if<A: Send, B: Send>(
-    parallel: bool,
-    a: impl FnOnce() -> A + Send,
-    b: impl FnOnce() -> B + Send,
-) -> (A, B) {
-    if parallel {
-        rayon::join(a, b)
-    } else {
-        (a(), b())
     }
 }
 
@@ -881,8 +869,6 @@ mod tests {
         assert!(path[..2_080].iter().all(|&k| cut.w.mantissa[k] > 0.0));
     }
 
-    /// The field of the serpentine from the target `(1, 1)`, its nested levels stopping as
-    /// `stop` allows.
     /// A part that the search for the band's parts proves too wide is one the direct solve
     /// would refuse (so skipping its try changes nothing), and a corridor is still offered to
     /// it and solved: a room 200 cells square and a corridor 3 cells wide, in one band. (From
@@ -917,6 +903,8 @@ mod tests {
         }
     }
 
+    /// The field of the serpentine from the target `(1, 1)`, its nested levels stopping as
+    /// `stop` allows.
     fn levels_with(grid: &Grid, reachable: &[bool], stop: &Stop) -> (ScaledW, LevelStats) {
         let target = [grid.index(1, 1)];
         let s = crate::field::harmonic::solve_w_for(grid, (reachable, &target), 1e-12, None, stop);

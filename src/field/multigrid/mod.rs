@@ -70,6 +70,7 @@ pub use cycle::Cycle;
 pub use kernels::set_portable;
 
 use super::grid::Grid;
+use super::join_if;
 use cycle::{Coarse, Hierarchy, split_at};
 use krylov::Krylov;
 use level::Level;
@@ -124,16 +125,11 @@ fn solve_all(
     // The coarse levels and CG's start each fault in fresh memory (most of their time on a
     // large grid): on a tall one, the two threads build them at once.
     let fine = Level::finest(grid.nx, grid.ny, unknown);
-    let (coarse, mut cg) = match split_at(&fine) {
-        Some(_) => rayon::join(
-            || Coarse::of(&fine),
-            || Krylov::start(&fine, grid, unknown, values),
-        ),
-        None => (
-            Coarse::of(&fine),
-            Krylov::start(&fine, grid, unknown, values),
-        ),
-    };
+    let (coarse, mut cg) = join_if(
+        split_at(&fine).is_some(),
+        || Coarse::of(&fine),
+        || Krylov::start(&fine, grid, unknown, values),
+    );
     let mut hierarchy = Hierarchy::on(fine, coarse, cycle);
     let mut stats = Stats {
         iterations: 0,
