@@ -299,9 +299,11 @@ impl Hierarchy {
                                 }
                                 let cells = &mut x[start..start + n];
                                 let active = &level.inv_diag[start + origin..start + origin + n];
+                                // Flushed like every value the cycle makes (see
+                                // `Level::relax_row_from_zero`).
                                 for ((x, a), c) in cells.iter_mut().zip(active).zip(&expanded[..n])
                                 {
-                                    *x += if *a != 0.0 { *c } else { 0.0 };
+                                    *x = flushed(*x + if *a != 0.0 { *c } else { 0.0 });
                                 }
                             },
                             #[inline(always)]

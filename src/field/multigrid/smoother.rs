@@ -233,7 +233,13 @@ impl Level {
     }
 
     /// [`Level::relax_row`] when `x` is 0: `x = b / diagonal` on colour `c`, 0 elsewhere. It
-    /// reads nothing of `x`, so a cycle that starts from 0 need not clear it first.
+    /// reads nothing of `x`, so a cycle that starts from 0 need not clear it first. Its values
+    /// are flushed as every pass's are: a later pass rewrites the whole row, the other colour
+    /// included, through `flushed`, so a kept value below [`super::kernels`]'s flush level
+    /// would read as itself before that pass and as 0 after it, and what a neighbour row saw
+    /// would depend on the order the rows are swept in (on a deep field, where such values
+    /// occur, the two threads' sweep of a tall level differed from one thread's in the last
+    /// bits, and so did every solve after it).
     #[inline(always)]
     pub fn relax_row_from_zero(
         &self,
@@ -248,7 +254,7 @@ impl Level {
         let x = &mut x[k - origin..k - origin + n];
         let (b, d) = (&b[k..k + n], &self.inv_diag[k..k + n]);
         for i in 0..n {
-            x[i] = (1.0 - keep[i]) * d[i] * b[i];
+            x[i] = flushed((1.0 - keep[i]) * d[i] * b[i]);
         }
     }
 
