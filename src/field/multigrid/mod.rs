@@ -257,22 +257,36 @@ mod tests {
             let slanted = i.abs_diff(j + 30) < 3 && j < 250;
             blocked[grid.index(i, j)] = across || slanted;
         }
-        let target = (300, 280);
-        let reachable = reachable_from(&grid, &blocked, target);
-        let mut unknown = reachable.clone();
+        let (one, two) = on_one_thread_and_two(&grid, &blocked, (300, 280));
+        assert!(one.0.relative_residual <= 1e-12, "{:?}", one.0);
+        assert_eq!(one.0, two.0);
+        assert!(bits(&one.1) == bits(&two.1), "the solutions differ");
+    }
+
+    /// The field of `target` solved to 1e-12 with tall levels swept by one thread, then by two.
+    fn on_one_thread_and_two(
+        grid: &Grid,
+        blocked: &[bool],
+        target: (usize, usize),
+    ) -> ((Stats, Vec<f64>), (Stats, Vec<f64>)) {
+        // The switch is global: one test at a time flips it.
+        static SWITCH: std::sync::Mutex<()> = std::sync::Mutex::new(());
+        let _only = SWITCH.lock().unwrap_or_else(|e| e.into_inner());
+        let mut unknown = reachable_from(grid, blocked, target);
         unknown[grid.index(target.0, target.1)] = false;
         let solve_with = |split: bool| {
             cycle::set_split(split);
             let mut w = vec![0.0; grid.len()];
             w[grid.index(target.0, target.1)] = 1.0;
-            let stats = solve(&grid, &unknown, &mut w, 1e-12, 200);
+            let stats = solve(grid, &unknown, &mut w, 1e-12, 200);
             cycle::set_split(true);
-            (stats, w.iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+            (stats, w)
         };
-        let (one, two) = (solve_with(false), solve_with(true));
-        assert!(one.0.relative_residual <= 1e-12, "{:?}", one.0);
-        assert_eq!(one.0, two.0);
-        assert!(one.1 == two.1, "the solutions differ");
+        (solve_with(false), solve_with(true))
+    }
+
+    fn bits(values: &[f64]) -> Vec<u64> {
+        values.iter().map(|v| v.to_bits()).collect()
     }
 
     /// As above on a field that decays through a serpentine of corridors to 1e-14 and below,
@@ -293,25 +307,13 @@ mod tests {
             blocked[grid.index(i, j)] =
                 i % 6 == 5 && if gap_below { j > 3 } else { j + 4 < grid.ny };
         }
-        let target = (1, 1);
-        let mut unknown = reachable_from(&grid, &blocked, target);
-        unknown[grid.index(target.0, target.1)] = false;
-        let solve_with = |split: bool| {
-            cycle::set_split(split);
-            let mut w = vec![0.0; grid.len()];
-            w[grid.index(target.0, target.1)] = 1.0;
-            let stats = solve(&grid, &unknown, &mut w, 1e-12, 200);
-            cycle::set_split(true);
-            (stats, w)
-        };
-        let (one, two) = (solve_with(false), solve_with(true));
+        let (one, two) = on_one_thread_and_two(&grid, &blocked, (1, 1));
         assert!(one.0.relative_residual <= 1e-12, "{:?}", one.0);
-        let deepest = (0..grid.len())
-            .filter(|&k| unknown[k])
-            .map(|k| one.1[k].abs());
-        assert!(deepest.fold(f64::MAX, f64::min) < 1e-14);
+        let free = (one.1.iter()).zip(&blocked).filter(|(_, b)| !**b);
+        let deepest = free.map(|(w, _)| w.abs()).fold(f64::MAX, f64::min);
+        assert!(deepest < 1e-14, "{deepest:e}");
         assert_eq!(one.0, two.0);
-        let differ = (one.1.iter().zip(&two.1)).filter(|(a, b)| a.to_bits() != b.to_bits());
+        let differ = (bits(&one.1).into_iter().zip(bits(&two.1))).filter(|(a, b)| a != b);
         assert_eq!(differ.count(), 0, "cells that differ");
     }
 
