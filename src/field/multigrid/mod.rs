@@ -285,6 +285,7 @@ mod tests {
         (solve_with(false), solve_with(true))
     }
 
+    /// The bit patterns of `values`, to compare solutions exactly.
     fn bits(values: &[f64]) -> Vec<u64> {
         values.iter().map(|v| v.to_bits()).collect()
     }
