@@ -44,7 +44,7 @@ const SPLIT_ROWS: usize = 256;
 
 /// The exact solve of the coarsest level: a dense Cholesky factor of its matrix.
 pub struct Coarsest {
-    /// Padded index of each unknown.
+    /// The index of each unknown in the level's vectors.
     cells: Vec<usize>,
     /// The Cholesky factor of the level's matrix (see [`Factor`]).
     factor: Factor,
@@ -53,32 +53,32 @@ pub struct Coarsest {
 impl Coarsest {
     /// The factor of `level`'s matrix.
     pub fn new(level: &Level) -> Self {
-        let cells: Vec<usize> = (0..level.ny)
-            .flat_map(|j| (0..level.nx).map(move |i| (i, j)))
-            .map(|(i, j)| level.pad(i, j))
-            .filter(|&k| level.active(k) != 0.0)
+        let unknowns: Vec<(usize, usize, usize)> = (0..level.ny)
+            .flat_map(|j| level.span(j).map(move |i| (i, j)))
+            .map(|(i, j)| (i, j, level.pad(i, j)))
+            .filter(|&(_, _, k)| level.active(k) != 0.0)
             .collect();
-        let n = cells.len();
+        let n = unknowns.len();
         let mut a = vec![0.0f64; n * n];
-        for (r, &k) in cells.iter().enumerate() {
-            for (c, &m) in cells.iter().enumerate() {
-                a[r * n + c] = if k == m {
-                    f64::from(level.diag_at(k))
-                } else if m == k + 1 {
-                    -f64::from(level.east_at(k))
-                } else if k == m + 1 {
-                    -f64::from(level.east_at(m))
-                } else if m == k + level.stride {
-                    -f64::from(level.north_at(k))
-                } else if k == m + level.stride {
-                    -f64::from(level.north_at(m))
+        for (r, &(i, j, _)) in unknowns.iter().enumerate() {
+            for (c, &(p, q, _)) in unknowns.iter().enumerate() {
+                a[r * n + c] = if (p, q) == (i, j) {
+                    f64::from(level.diag_at(i, j))
+                } else if (p, q) == (i + 1, j) {
+                    -f64::from(level.east_at(i, j))
+                } else if (i, j) == (p + 1, q) {
+                    -f64::from(level.east_at(p, q))
+                } else if (p, q) == (i, j + 1) {
+                    -f64::from(level.north_at(i, j))
+                } else if (i, j) == (p, q + 1) {
+                    -f64::from(level.north_at(p, q))
                 } else {
                     0.0
                 };
             }
         }
         Self {
-            cells,
+            cells: unknowns.into_iter().map(|(_, _, k)| k).collect(),
             factor: Factor::new(a, n),
         }
     }
@@ -236,6 +236,9 @@ impl Hierarchy {
                         #[inline(always)]
                         |j, x| {
                             let cols = level.span(j);
+                            if cols.is_empty() {
+                                return;
+                            }
                             let residual = &mut residual[..cols.len()];
                             level.residual_row(j, (x, origin), b, residual);
                             let base = coarse.pad(cols.start / 2, j / 2) - c_origin;
@@ -289,6 +292,9 @@ impl Hierarchy {
                             #[inline(always)]
                             |j, x| {
                                 let cols = level.span(j);
+                                if cols.is_empty() {
+                                    return;
+                                }
                                 let (start, n) = (level.pad(cols.start, j) - origin, cols.len());
                                 let base = coarse.pad(cols.start / 2, j / 2);
                                 let parents = &correction[base..base + n.div_ceil(2)];

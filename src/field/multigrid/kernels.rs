@@ -51,7 +51,41 @@ pub fn wide<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 
-/// The five shifted views of a padded vector that a 5-point stencil reads for a run of `n`
+/// Where a run of cells starts in a level's vector, and where the runs beside it in the rows
+/// below and above start (the layout is ragged: see `level.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct At {
+    /// The run in the row below.
+    pub down: usize,
+    /// The run itself.
+    pub mid: usize,
+    /// The run in the row above.
+    pub up: usize,
+}
+
+impl At {
+    /// The runs `i` cells further along their rows.
+    #[inline(always)]
+    pub fn plus(self, i: usize) -> Self {
+        Self {
+            down: self.down + i,
+            mid: self.mid + i,
+            up: self.up + i,
+        }
+    }
+
+    /// The same runs in a slice of the vector that starts at index `origin`.
+    #[inline(always)]
+    pub fn from(self, origin: usize) -> Self {
+        Self {
+            down: self.down - origin,
+            mid: self.mid - origin,
+            up: self.up - origin,
+        }
+    }
+}
+
+/// The five shifted views of a level's vector that a 5-point stencil reads for a run of `n`
 /// cells: the cells themselves and their west, east, up (north) and down (south) neighbours.
 /// Every row loop of the solver is written over these slices, so that the compiler sees
 /// straight-line element-wise code with no bounds checks inside the loop.
@@ -70,16 +104,16 @@ pub struct Neighbourhood<'a, T> {
 }
 
 impl<'a, T> Neighbourhood<'a, T> {
-    /// The neighbourhood of the `n` cells from padded index `k` of a vector whose rows are
-    /// `stride` apart.
+    /// The neighbourhood of the `n` cells of `x` at `at`.
     #[inline(always)]
-    pub fn of(x: &'a [T], k: usize, n: usize, stride: usize) -> Self {
+    pub fn of(x: &'a [T], at: At, n: usize) -> Self {
+        let k = at.mid;
         Self {
             mid: &x[k..k + n],
             west: &x[k - 1..k - 1 + n],
             east: &x[k + 1..k + 1 + n],
-            up: &x[k + stride..k + stride + n],
-            down: &x[k - stride..k - stride + n],
+            up: &x[at.up..at.up + n],
+            down: &x[at.down..at.down + n],
         }
     }
 }

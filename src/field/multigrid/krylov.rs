@@ -10,7 +10,7 @@ use super::kernels::{Neighbourhood, dot, flushed, for_cycle, wide};
 use super::level::Level;
 use crate::field::Grid;
 
-/// The CG vectors on the fine level's padded layout. The search direction is kept in f32 as
+/// The CG vectors on the fine level's layout. The search direction is kept in f32 as
 /// `q = scale · p`, scaled like the cycle's output it is made from (see [`Krylov::iterate`]);
 /// the solution `x` and the residual `r` stay in f64, since they carry the solution's precision.
 pub struct Krylov {
@@ -31,19 +31,20 @@ pub struct Krylov {
 impl Krylov {
     /// The starting guess (the unknown cells of `values`), the right-hand side `b` (the sum of
     /// each unknown cell's fixed neighbours; cells outside the grid are its ring of zeros) and
-    /// the initial residual `r = b − A x`, on the padded layout of the fine level.
+    /// the initial residual `r = b − A x`, on the layout of the fine level.
     pub fn start(fine: &Level, grid: &Grid, unknown: &[bool], values: &[f64]) -> Self {
-        let (nx, ny, stride) = (grid.nx, grid.ny, fine.stride);
+        let (nx, ny) = (grid.nx, grid.ny);
         let n = fine.len();
         // `fixed` holds the Dirichlet values and then becomes the residual: fresh memory costs
-        // page faults.
+        // page faults. The level stores every cell next to an active one (see `level.rs`).
         let mut x = vec![0.0; n];
         let mut fixed = vec![0.0; n];
         for j in 0..ny {
-            let (k, row) = (fine.pad(0, j), j * nx..(j + 1) * nx);
-            for (((x, f), v), u) in x[k..k + nx]
+            let (k, cols) = fine.stored(j);
+            let row = j * nx + cols.start..j * nx + cols.end;
+            for (((x, f), v), u) in x[k..k + cols.len()]
                 .iter_mut()
-                .zip(&mut fixed[k..k + nx])
+                .zip(&mut fixed[k..k + cols.len()])
                 .zip(&values[row.clone()])
                 .zip(&unknown[row])
             {
@@ -58,28 +59,28 @@ impl Krylov {
         let mut rows = [vec![0.0; nx], vec![0.0; nx]];
         for j in 0..ny + 2 {
             if j >= 2 {
-                let k = fine.pad(0, j - 2);
-                fixed[k..k + nx].copy_from_slice(&rows[j % 2]);
+                let (k, cols) = fine.stored(j - 2);
+                fixed[k..k + cols.len()].copy_from_slice(&rows[j % 2][cols]);
             }
             if j < ny {
-                let k = fine.pad(0, j);
-                let f = Neighbourhood::of(&fixed, k, nx, stride);
-                let u = Neighbourhood::of(&x, k, nx, stride);
-                let d = &fine.inv_diag[k..k + nx];
+                let (at, cols) = fine.run(j);
+                let f = Neighbourhood::of(&fixed, at, cols.len());
+                let u = Neighbourhood::of(&x, at, cols.len());
+                let d = &fine.inv_diag[at.mid..at.mid + cols.len()];
                 let row = &mut rows[j % 2];
                 row.fill(0.0);
                 let mut b_row = 0.0;
-                for i in fine.span(j) {
-                    if d[i] != 0.0 {
-                        let f = [f.west[i], f.east[i], f.up[i], f.down[i]];
+                for (l, i) in cols.clone().enumerate() {
+                    if d[l] != 0.0 {
+                        let f = [f.west[l], f.east[l], f.up[l], f.down[l]];
                         let (b, r) =
-                            residual_at(f, [u.mid[i], u.west[i], u.east[i], u.up[i], u.down[i]]);
+                            residual_at(f, [u.mid[l], u.west[l], u.east[l], u.up[l], u.down[l]]);
                         b_row += b * b;
                         row[i] = r;
                     }
                 }
                 bb += b_row;
-                rr += row_dot(row, fine.span(j));
+                rr += row_dot(row, cols);
             }
         }
         Self {
@@ -129,23 +130,23 @@ impl Krylov {
         let mut row = vec![0.0; nx];
         let mut rr = 0.0;
         for j in 0..ny {
-            let k = fine.pad(0, j);
-            let u = Neighbourhood::of(&self.x, k, nx, fine.stride);
-            let d = &fine.inv_diag[k..k + nx];
-            for i in fine.span(j) {
-                if d[i] != 0.0 {
+            let (at, cols) = fine.run(j);
+            let u = Neighbourhood::of(&self.x, at, cols.len());
+            let d = &fine.inv_diag[at.mid..at.mid + cols.len()];
+            for (l, i) in cols.clone().enumerate() {
+                if d[l] != 0.0 {
                     let f = [
                         if i > 0 { fixed(i - 1, j) } else { 0.0 },
                         if i + 1 < nx { fixed(i + 1, j) } else { 0.0 },
                         if j + 1 < ny { fixed(i, j + 1) } else { 0.0 },
                         if j > 0 { fixed(i, j - 1) } else { 0.0 },
                     ];
-                    let u = [u.mid[i], u.west[i], u.east[i], u.up[i], u.down[i]];
+                    let u = [u.mid[l], u.west[l], u.east[l], u.up[l], u.down[l]];
                     row[i] = residual_at(f, u).1;
                 }
             }
-            rr += row_dot(&row, fine.span(j));
-            row[fine.span(j)].fill(0.0);
+            rr += row_dot(&row, cols.clone());
+            row[cols].fill(0.0);
         }
         self.relative_of(rr)
     }
@@ -202,10 +203,11 @@ impl Krylov {
     pub fn copy_out(&self, fine: &Level, grid: &Grid, unknown: &[bool], values: &mut [f64]) {
         let nx = grid.nx;
         for j in 0..grid.ny {
-            let (k, row) = (fine.pad(0, j), j * nx..(j + 1) * nx);
+            let (k, cols) = fine.stored(j);
+            let row = j * nx + cols.start..j * nx + cols.end;
             for ((v, x), u) in values[row.clone()]
                 .iter_mut()
-                .zip(&self.x[k..k + nx])
+                .zip(&self.x[k..k + cols.len()])
                 .zip(&unknown[row])
             {
                 if *u {
@@ -224,7 +226,7 @@ impl Krylov {
         let Self { q, rows, dots, .. } = self;
         let dots = &mut dots[..level.ny];
         // `q = z + γ q` on `rows` and `q · A q` of the rows `applied` among them, with `q`
-        // starting at padded index `origin` and `dots` at row `first`.
+        // starting at index `origin` and `dots` at row `first`.
         let part = |rows: Range<usize>,
                     applied: Range<usize>,
                     (q, origin): (&mut [f32], usize),
@@ -289,7 +291,7 @@ impl Krylov {
             ..
         } = self;
         let (q, dots) = (&*q, &mut dots[..level.ny]);
-        // The step on `rows`, with `x`, `r` and `out` starting at padded index `origin` and
+        // The step on `rows`, with `x`, `r` and `out` starting at index `origin` and
         // `dots` at the first row.
         let part = |rows: Range<usize>,
                     origin: usize,
@@ -340,7 +342,7 @@ impl Krylov {
     }
 }
 
-/// `q · A q` on row `j` (`q` starting at padded index `origin`), with `row` to hold `A q`.
+/// `q · A q` on row `j` (`q` starting at index `origin`), with `row` to hold `A q`.
 #[inline(always)]
 fn curvature(level: &Level, (q, origin): (&[f32], usize), j: usize, row: &mut [f64]) -> f64 {
     apply_row(level, (q, origin), j, row);
@@ -350,11 +352,12 @@ fn curvature(level: &Level, (q, origin): (&[f32], usize), j: usize, row: &mut [f
 
 /// `A q` on row `j` of the fine level, in f64, into `out`: the 5-point stencil on every cell,
 /// so it is `A q` on the active cells only (`q` is 0 on the others). `q` holds f32 values, so
-/// the sums are exact in f64. `q` starts at padded index `origin`.
+/// the sums are exact in f64. `q` starts at index `origin`.
 #[inline(always)]
 fn apply_row(level: &Level, (q, origin): (&[f32], usize), j: usize, out: &mut [f64]) {
-    let (k, n) = level.row(j);
-    let q = Neighbourhood::of(q, k - origin, n, level.stride);
+    let (at, cols) = level.run(j);
+    let n = cols.len();
+    let q = Neighbourhood::of(q, at.from(origin), n);
     let out = &mut out[..n];
     for i in 0..n {
         out[i] = 4.0 * f64::from(q.mid[i])

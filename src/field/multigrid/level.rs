@@ -1,5 +1,7 @@
-//! One level of the hierarchy ([`Level`]): its padded layout, its stencil, the spans of its
+//! One level of the hierarchy ([`Level`]): its ragged layout, its stencil, the spans of its
 //! rows, and how the next coarser level is made from it (Galerkin coarsening).
+
+use super::kernels::At;
 
 /// Factor on the Galerkin coarse operators (see [`Level::coarsen`]).
 const COARSE_SCALE: f32 = 0.5;
@@ -21,18 +23,19 @@ pub enum Stencil {
     },
 }
 
-/// One level of the hierarchy: a padded grid (a ring of inactive cells around it, row stride
-/// `nx + 2`) with a 5-point stencil. Inactive cells have `inv_diag = 0` and no coupling, so
-/// every sweep can run over whole rows without branches, and the vectors a level works on hold
-/// 0 there. Each row is processed only over its span ([`Level::span`]), outside which every
-/// cell is inactive: a nested solve's box can be mostly empty.
+/// One level of the hierarchy: a grid with a ring of inactive cells around it and a 5-point
+/// stencil, stored ragged: each row holds only the columns that the passes over it and over
+/// the rows beside it read (its span and theirs, a little wider: see [`Layout::new`]), one
+/// row after another. A nested part's box can be mostly empty (the rooms map's: 5.5 times its rows'
+/// spans), and its vectors, its stencil and their setup then cost the spans, not the box.
+/// Inactive cells have `inv_diag = 0` and no coupling, so every sweep can run over a row's
+/// span without branches, and the vectors a level works on hold 0 there. Each row is
+/// processed only over its span ([`Level::span`]), outside which every cell is inactive.
 pub struct Level {
     /// Cells along x.
     pub nx: usize,
     /// Cells along y.
     pub ny: usize,
-    /// Distance between rows in the padded layout.
-    pub stride: usize,
     /// `1 / diagonal` on active cells, 0 on inactive ones.
     pub inv_diag: Vec<f32>,
     /// The stencil.
@@ -43,6 +46,61 @@ pub struct Level {
     /// cells, `lo` even. The two rows share it so that their residuals restrict onto exactly
     /// the coarse cells `[lo / 2, ⌈hi / 2⌉)`, which hold every active coarse cell of that row.
     spans: Vec<[usize; 2]>,
+    /// The layout (see [`Layout`]).
+    layout: Layout,
+}
+
+/// Where a level's rows are stored. Rows and columns are counted with the ring: padded row
+/// `r` is the grid's row `r − 1`, padded column `c` its column `c − 1`. Padded row `r` holds
+/// the padded columns `first[r] .. first[r] + (start[r + 1] − start[r])`, from index
+/// `start[r]` of a level's vectors.
+struct Layout {
+    /// Per padded row: its first stored padded column.
+    first: Vec<usize>,
+    /// Per padded row, and one more: where it starts in a level's vectors (the last entry is
+    /// where the rows end).
+    start: Vec<usize>,
+}
+
+impl Layout {
+    /// The layout of a level `nx` wide and `ny` high whose pairs of rows have `spans`: padded
+    /// row `r` stores the spans of the grid's rows `r − 2`, `r − 1` and `r` (the rows whose
+    /// passes read it), each widened by a cell to the west (a cell's west neighbour) and two
+    /// to the east (its east neighbour, and that one's own east, which [`Level::coarsen`]
+    /// reads), within the ring.
+    fn new(nx: usize, ny: usize, spans: &[[usize; 2]]) -> Self {
+        let rows = ny + 2;
+        let (mut first, mut start) = (Vec::with_capacity(rows), Vec::with_capacity(rows + 1));
+        // One spare element before the rows and two after them (see [`Level::run`]).
+        start.push(1);
+        for r in 0..rows {
+            let read_by = r.saturating_sub(2)..(r + 1).min(ny);
+            let (lo, hi) = read_by
+                .map(|j| spans[j / 2])
+                .filter(|[lo, hi]| lo < hi)
+                // Cells `lo − 1 .. hi + 2`: padded columns `lo .. hi + 3`.
+                .map(|[lo, hi]| (lo, (hi + 3).min(nx + 2)))
+                .fold((usize::MAX, 0), |(a, b), (lo, hi)| (a.min(lo), b.max(hi)));
+            let (lo, hi) = if lo < hi { (lo, hi) } else { (0, 0) };
+            first.push(lo);
+            start.push(start[r] + hi - lo);
+        }
+        Self { first, start }
+    }
+
+    /// The index of padded column `c` of padded row `r`, which the row stores.
+    #[inline(always)]
+    fn at(&self, c: usize, r: usize) -> usize {
+        self.start[r] + c - self.first[r]
+    }
+
+    /// The index of padded column `c` of padded row `r`, if the row stores it.
+    fn stored(&self, c: usize, r: usize) -> Option<usize> {
+        let (first, width) = (*self.first.get(r)?, self.start[r + 1] - self.start[r]);
+        (first..first + width)
+            .contains(&c)
+            .then(|| self.start[r] + c - first)
+    }
 }
 
 /// [`Level::spans`] of a level `nx` wide and `ny` high with the given active cells.
@@ -64,23 +122,54 @@ fn spans(nx: usize, ny: usize, active: impl Fn(usize, usize) -> bool) -> Vec<[us
 }
 
 impl Level {
-    /// The padded length: a ring of inactive cells, plus one more row so that reading the
-    /// north neighbour of the top ring stays in bounds.
+    /// The length of the level's vectors.
     pub fn len(&self) -> usize {
-        self.stride * (self.ny + 3)
+        self.layout.start[self.ny + 2] + 2
     }
 
-    /// The padded index of cell `(i, j)`.
+    /// The index of cell `(i, j)`, which the layout must store (every cell of a row's span
+    /// and its neighbours: see [`Layout::new`]).
     #[inline(always)]
     pub fn pad(&self, i: usize, j: usize) -> usize {
-        (j + 1) * self.stride + i + 1
+        self.layout.at(i + 1, j + 1)
     }
 
-    /// The padded index where row `j` begins (its cell in the ring, west of `(0, j)`): split
-    /// there, a vector's rows below `j` and its rows from `j` on are two disjoint slices.
+    /// Where the run of cells from `(i, j)` and the runs beside it in rows `j − 1` and
+    /// `j + 1` start: the neighbourhood of cells in row `j`'s span.
+    #[inline(always)]
+    pub fn around(&self, i: usize, j: usize) -> At {
+        At {
+            down: self.layout.at(i + 1, j),
+            mid: self.layout.at(i + 1, j + 1),
+            up: self.layout.at(i + 1, j + 2),
+        }
+    }
+
+    /// Where the run of row `j`'s span and the runs beside it start, and the span. An empty
+    /// span's run is placed just inside the row's storage (one past its start: the level's
+    /// vectors have a spare element before the rows and two after them), so that its empty
+    /// neighbourhood slices stay in bounds, in the part of the vector the row is in.
+    #[inline(always)]
+    pub fn run(&self, j: usize) -> (At, std::ops::Range<usize>) {
+        let cols = self.span(j);
+        let at = if cols.is_empty() {
+            let k = self.layout.start[j + 1] + 1;
+            At {
+                down: k,
+                mid: k,
+                up: k,
+            }
+        } else {
+            self.around(cols.start, j)
+        };
+        (at, cols)
+    }
+
+    /// The index where row `j`'s storage begins: split there, a vector's rows below `j` and
+    /// its rows from `j` on are two disjoint slices.
     #[inline(always)]
     pub fn row_start(&self, j: usize) -> usize {
-        (j + 1) * self.stride
+        self.layout.start[j + 1]
     }
 
     /// The columns of row `j` that a pass goes over (see [`Level::spans`]).
@@ -90,22 +179,44 @@ impl Level {
         lo..hi
     }
 
-    /// Where row `j`'s span starts in the padded layout, and how many cells it has.
+    /// Where row `j`'s span starts in the level's vectors, and how many cells it has.
     #[inline(always)]
     pub fn row(&self, j: usize) -> (usize, usize) {
-        let cols = self.span(j);
-        (self.pad(cols.start, j), cols.len())
+        let (at, cols) = self.run(j);
+        (at.mid, cols.len())
+    }
+
+    /// The cells of row `j` inside the grid that the layout stores, and the index of the
+    /// first.
+    pub fn stored(&self, j: usize) -> (usize, std::ops::Range<usize>) {
+        let r = j + 1;
+        let first = self.layout.first[r];
+        let width = self.layout.start[r + 1] - self.layout.start[r];
+        // Padded columns [first, first + width) less the ring's two: cells from first − 1.
+        let cells = first.max(1) - 1..(first + width).min(self.nx + 1).saturating_sub(1);
+        let cells = cells.start..cells.end.max(cells.start);
+        let k = if cells.is_empty() {
+            0
+        } else {
+            self.pad(cells.start, j)
+        };
+        (k, cells)
     }
 
     /// The fine level of the `grid`'s `unknown` cells.
     pub fn finest(nx: usize, ny: usize, unknown: &[bool]) -> Self {
-        let stride = nx + 2;
-        let n = stride * (ny + 3);
-        let mut inv_diag = vec![0.0; n];
+        let spans = spans(nx, ny, |i, j| unknown[j * nx + i]);
+        let layout = Layout::new(nx, ny, &spans);
+        let mut inv_diag = vec![0.0; layout.start[ny + 2] + 2];
         for j in 0..ny {
-            let k = (j + 1) * stride + 1;
-            let row = &unknown[j * nx..(j + 1) * nx];
-            for (inv, u) in inv_diag[k..k + nx].iter_mut().zip(row) {
+            let [lo, hi] = spans[j / 2];
+            let cols = lo..hi;
+            if cols.is_empty() {
+                continue;
+            }
+            let k = layout.at(cols.start + 1, j + 1);
+            let row = &unknown[j * nx + cols.start..j * nx + cols.end];
+            for (inv, u) in inv_diag[k..k + cols.len()].iter_mut().zip(row) {
                 *inv = if *u { 0.25 } else { 0.0 };
             }
         }
@@ -113,41 +224,71 @@ impl Level {
         Self {
             nx,
             ny,
-            stride,
             inv_diag,
             stencil: Stencil::Uniform,
             unknowns,
-            spans: spans(nx, ny, |i, j| unknown[j * nx + i]),
+            spans,
+            layout,
         }
     }
 
-    /// Whether padded cell `k` is active, as 1 or 0.
+    /// Whether the cell at index `k` is active, as 1 or 0.
     pub fn active(&self, k: usize) -> f32 {
         if self.inv_diag[k] != 0.0 { 1.0 } else { 0.0 }
     }
 
-    /// The diagonal at padded cell `k`.
-    pub fn diag_at(&self, k: usize) -> f32 {
+    /// The diagonal at padded `(c, r)` (0 where not stored).
+    fn diag_padded(&self, c: usize, r: usize) -> f32 {
+        let Some(k) = self.layout.stored(c, r) else {
+            return 0.0;
+        };
         match &self.stencil {
             Stencil::Uniform => 4.0 * self.active(k),
             Stencil::Coefficients { diag, .. } => diag[k],
         }
     }
 
-    /// East coupling of padded cell `k`.
-    pub fn east_at(&self, k: usize) -> f32 {
+    /// The coupling of the cell at padded `(c, r)` to its east neighbour (0 where not stored).
+    fn east_padded(&self, c: usize, r: usize) -> f32 {
+        let Some(k) = self.layout.stored(c, r) else {
+            return 0.0;
+        };
         match &self.stencil {
-            Stencil::Uniform => self.active(k) * self.active(k + 1),
+            Stencil::Uniform => {
+                let east = self.layout.stored(c + 1, r).map_or(0.0, |m| self.active(m));
+                self.active(k) * east
+            }
             Stencil::Coefficients { east, .. } => east[k],
         }
     }
 
-    /// North coupling of padded cell `k`.
-    pub fn north_at(&self, k: usize) -> f32 {
+    /// The coupling of the cell at padded `(c, r)` to its north neighbour (0 where not stored).
+    fn north_padded(&self, c: usize, r: usize) -> f32 {
+        let Some(k) = self.layout.stored(c, r) else {
+            return 0.0;
+        };
         match &self.stencil {
-            Stencil::Uniform => self.active(k) * self.active(k + self.stride),
+            Stencil::Uniform => {
+                let north = self.layout.stored(c, r + 1).map_or(0.0, |m| self.active(m));
+                self.active(k) * north
+            }
             Stencil::Coefficients { north, .. } => north[k],
         }
+    }
+
+    /// The diagonal at cell `(i, j)`.
+    pub fn diag_at(&self, i: usize, j: usize) -> f32 {
+        self.diag_padded(i + 1, j + 1)
+    }
+
+    /// East coupling of cell `(i, j)`.
+    pub fn east_at(&self, i: usize, j: usize) -> f32 {
+        self.east_padded(i + 1, j + 1)
+    }
+
+    /// North coupling of cell `(i, j)`.
+    pub fn north_at(&self, i: usize, j: usize) -> f32 {
+        self.north_padded(i + 1, j + 1)
     }
 
     /// The Galerkin coarse level `R A P` for piecewise-constant `P` (coarse cell `(I, J)` owns
@@ -155,26 +296,50 @@ impl Level {
     /// its children's less twice the couplings inside it (once for each ordering of a pair),
     /// and two coarse cells couple by the sum of the fine couplings across their shared side.
     /// Children beyond the fine grid fall in its inactive ring and add nothing.
+    ///
+    /// Coarse row `J`'s active cells are the parents of its fine pair's span, `[lo / 2,
+    /// ⌈hi / 2⌉)` (a parent of an active cell is active: a part of the grid has a Dirichlet
+    /// neighbour, so no group of its cells has a zero row sum), and only those are computed;
+    /// the others are inactive, with no coupling.
     pub fn coarsen(&self) -> Self {
         let (nx, ny) = (self.nx.div_ceil(2), self.ny.div_ceil(2));
-        let stride = nx + 2;
-        let n = stride * (ny + 3);
+        // Coarse row J's columns: the parents of fine pair J's span.
+        let parents = |jj: usize| {
+            let [lo, hi] = self.spans[jj];
+            lo / 2..hi.div_ceil(2)
+        };
+        let spans: Vec<[usize; 2]> = (0..ny.div_ceil(2))
+            .map(|p| {
+                let rows = (2 * p..(2 * p + 2).min(ny)).map(parents);
+                let (lo, hi) = rows
+                    .filter(|cols| !cols.is_empty())
+                    .fold((usize::MAX, 0), |(a, b), c| (a.min(c.start), b.max(c.end)));
+                if lo < hi { [lo / 2 * 2, hi] } else { [0, 0] }
+            })
+            .collect();
+        let layout = Layout::new(nx, ny, &spans);
+        let n = layout.start[ny + 2] + 2;
         let (mut diag, mut east, mut north) = (vec![0.0f32; n], vec![0.0; n], vec![0.0; n]);
-        let s = self.stride;
         for j in 0..ny {
-            for i in 0..nx {
-                let c = (j + 1) * stride + i + 1;
-                // Children: a (2I, 2J), b (2I+1, 2J), d (2I, 2J+1), e (2I+1, 2J+1).
-                let a = self.pad(2 * i, 2 * j);
-                let (b, d, e) = (a + 1, a + s, a + s + 1);
-                let inside =
-                    self.east_at(a) + self.east_at(d) + self.north_at(a) + self.north_at(b);
-                let sum = self.diag_at(a) + self.diag_at(b) + self.diag_at(d) + self.diag_at(e);
+            for i in parents(j) {
+                let c = layout.at(i + 1, j + 1);
+                // Children, in padded coordinates: a (2I, 2J), b (2I+1, 2J), d (2I, 2J+1),
+                // e (2I+1, 2J+1).
+                let (a, r) = (2 * i + 1, 2 * j + 1);
+                let (b, up) = (a + 1, r + 1);
+                let inside = self.east_padded(a, r)
+                    + self.east_padded(a, up)
+                    + self.north_padded(a, r)
+                    + self.north_padded(b, r);
+                let sum = self.diag_padded(a, r)
+                    + self.diag_padded(b, r)
+                    + self.diag_padded(a, up)
+                    + self.diag_padded(b, up);
                 // Piecewise-constant transfers make R A P twice the rediscretized 2h stencil,
                 // which under-corrects smooth errors; the factor restores its size.
                 diag[c] = COARSE_SCALE * (sum - 2.0 * inside);
-                east[c] = COARSE_SCALE * (self.east_at(b) + self.east_at(e));
-                north[c] = COARSE_SCALE * (self.north_at(d) + self.north_at(e));
+                east[c] = COARSE_SCALE * (self.east_padded(b, r) + self.east_padded(b, up));
+                north[c] = COARSE_SCALE * (self.north_padded(a, up) + self.north_padded(b, up));
             }
         }
         let inv_diag: Vec<f32> = diag
@@ -182,15 +347,76 @@ impl Level {
             .map(|&d| if d > 0.0 { 1.0 / d } else { 0.0 })
             .collect();
         let unknowns = diag.iter().filter(|&&d| d > 0.0).count();
-        let spans = spans(nx, ny, |i, j| diag[(j + 1) * stride + i + 1] > 0.0);
         Self {
             nx,
             ny,
-            stride,
             inv_diag,
             stencil: Stencil::Coefficients { diag, east, north },
             unknowns,
             spans,
+            layout,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A thin band across a wide box, with a gap of empty rows: every level of its hierarchy
+    /// stores what its passes read (each span cell's neighbours, and the coarse cells its
+    /// pairs restrict onto), and the finest level stores a tenth of its box, not all of it.
+    #[test]
+    fn a_band_stores_its_spans_and_what_they_read() {
+        let (nx, ny) = (400, 301);
+        let inside = |i: usize, j: usize| {
+            let band = (i as f64 - 1.2 * j as f64 - 20.0).abs() <= 8.0;
+            band && !(120..126).contains(&j)
+        };
+        let unknown: Vec<bool> = (0..nx * ny).map(|k| inside(k % nx, k / nx)).collect();
+        let mut level = Level::finest(nx, ny, &unknown);
+        assert!(
+            10 * level.len() < (nx + 2) * (ny + 3),
+            "{} stored",
+            level.len()
+        );
+        loop {
+            let stored = |i: isize, j: isize| {
+                let (c, r) = ((i + 1) as usize, (j + 1) as usize);
+                level.layout.stored(c, r).is_some()
+            };
+            for j in 0..level.ny {
+                for i in level.span(j) {
+                    let (i, j) = (i as isize, j as isize);
+                    let reads = [(i - 1, j), (i, j), (i + 1, j), (i + 2, j), (i, j - 1)];
+                    // Within the ring (beyond it, `Level::east_at` reads 0).
+                    let ring = level.nx as isize;
+                    for (a, b) in reads
+                        .into_iter()
+                        .chain([(i, j + 1)])
+                        .filter(|c| c.0 <= ring)
+                    {
+                        assert!(stored(a, b), "({a}, {b}) around ({i}, {j})");
+                    }
+                    let k = level.pad(i as usize, j as usize);
+                    assert_eq!(
+                        level.active(k) != 0.0,
+                        level.diag_at(i as usize, j as usize) > 0.0
+                    );
+                }
+            }
+            if level.nx <= 2 || level.unknowns <= 4 {
+                break;
+            }
+            let coarse = level.coarsen();
+            for j in 0..level.ny {
+                for i in level.span(j).step_by(2) {
+                    let parent = coarse.layout.stored(i / 2 + 1, j / 2 + 1);
+                    assert!(parent.is_some(), "the parent of ({i}, {j})");
+                }
+            }
+            assert!(coarse.unknowns > 0);
+            level = coarse;
         }
     }
 }

@@ -2,7 +2,7 @@
 //! residual of a row. Every function here runs inside [`super::kernels::wide`], so each is
 //! `#[inline(always)]` (the inlining rule of `kernels.rs`).
 
-use super::kernels::{Neighbourhood, flushed};
+use super::kernels::{At, Neighbourhood, flushed};
 use super::level::{Level, Stencil};
 
 /// Cells a short row's update computes at once: one AVX2 register of f32.
@@ -11,19 +11,19 @@ const LANES: usize = 8;
 /// Rows at least this long are updated through a buffer (see [`in_place`]).
 const LONG_ROW: usize = 256;
 
-/// Gauss-Seidel's new values `out` of the cells from padded index `o` (row position `i`, for
-/// `keep`) on the finest level's uniform stencil, from `x` (which starts at padded index
-/// `origin`); `keep`'s cells keep their value.
+/// Gauss-Seidel's new values `out` of the cells at `at` (row position `i`, for `keep`) on the
+/// finest level's uniform stencil, from `x` (which starts at index `origin`); `keep`'s cells
+/// keep their value.
 #[inline(always)]
 fn uniform(
     out: &mut [f32],
     (x, origin): (&[f32], usize),
     (b, d, keep): (&[f32], &[f32], &[f32]),
-    (o, i): (usize, usize),
-    s: usize,
+    (at, i): (At, usize),
 ) {
     let n = out.len();
-    let x = Neighbourhood::of(x, o - origin, n, s);
+    let o = at.mid;
+    let x = Neighbourhood::of(x, at.from(origin), n);
     let (b, d, keep) = (&b[o..o + n], &d[o..o + n], &keep[i..i + n]);
     for l in 0..n {
         let new = d[l] * (b[l] + x.west[l] + x.east[l] + x.up[l] + x.down[l]);
@@ -38,15 +38,15 @@ fn coefficients(
     (x, origin): (&[f32], usize),
     (b, d, keep): (&[f32], &[f32], &[f32]),
     (east, north): (&[f32], &[f32]),
-    (o, i): (usize, usize),
-    s: usize,
+    (at, i): (At, usize),
 ) {
     let n = out.len();
-    let x = Neighbourhood::of(x, o - origin, n, s);
+    let o = at.mid;
+    let x = Neighbourhood::of(x, at.from(origin), n);
     let (b, d, keep) = (&b[o..o + n], &d[o..o + n], &keep[i..i + n]);
     let (e, no) = (
-        Neighbourhood::of(east, o, n, s),
-        Neighbourhood::of(north, o, n, s),
+        Neighbourhood::of(east, at, n),
+        Neighbourhood::of(north, at, n),
     );
     for l in 0..n {
         let new = d[l]
@@ -59,7 +59,7 @@ fn coefficients(
     }
 }
 
-/// Writes the new values of the `n` cells of a row from padded index `k`: `new(out, x, i)`
+/// Writes the new values of the `n` cells of a row from index `k`: `new(out, x, i)`
 /// computes those of cells `i .. i + out.len()` of the row from the old values around them.
 ///
 /// A short row is updated in place, [`LANES`] cells at a time, each chunk's new values stored
@@ -169,7 +169,7 @@ impl Part {
         }
     }
 
-    /// The padded index where the part's slice of a level's vector starts.
+    /// The index where the part's slice of a level's vector starts.
     pub fn origin(self, level: &Level) -> usize {
         match self {
             Part::Above { mid } => level.row_start(mid),
@@ -209,24 +209,31 @@ impl Level {
         t: &mut [f32],
         keep: &Keep,
     ) {
-        let (k, n) = self.row(j);
-        let keep = &keep[(c + j) % 2][self.span(j)];
-        let (s, d) = (self.stride, &self.inv_diag);
+        let (at, cols) = self.run(j);
+        let n = cols.len();
+        let keep = &keep[(c + j) % 2][cols];
+        let d = &self.inv_diag;
         match &self.stencil {
             Stencil::Uniform => in_place(
                 x,
-                (k - origin, n),
+                (at.mid - origin, n),
                 t,
                 #[inline(always)]
-                |out, x, i| uniform(out, (x, origin), (b, d, keep), (k + i, i), s),
+                |out, x, i| uniform(out, (x, origin), (b, d, keep), (at.plus(i), i)),
             ),
             Stencil::Coefficients { east, north, .. } => in_place(
                 x,
-                (k - origin, n),
+                (at.mid - origin, n),
                 t,
                 #[inline(always)]
                 |out, x, i| {
-                    coefficients(out, (x, origin), (b, d, keep), (east, north), (k + i, i), s)
+                    coefficients(
+                        out,
+                        (x, origin),
+                        (b, d, keep),
+                        (east, north),
+                        (at.plus(i), i),
+                    )
                 },
             ),
         }
@@ -266,7 +273,7 @@ impl Level {
     /// before any pass reads row `r`; `after(r)` once every pass is done with rows `r − 1`,
     /// `r` and `r + 1` (for the rows `part` gives them). With `zero_start`, the first pass
     /// takes `x` as 0, whatever it holds. `x` is the part's slice of the level's vector, from
-    /// padded index [`Part::origin`].
+    /// index [`Part::origin`].
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub fn sweep(
@@ -308,12 +315,14 @@ impl Level {
     }
 
     /// The residual `b − A x` of row `j` into `row` (0 on inactive cells); `x` starts at
-    /// padded index `origin`.
+    /// index `origin`.
     #[inline(always)]
     pub fn residual_row(&self, j: usize, (x, origin): (&[f32], usize), b: &[f32], row: &mut [f32]) {
-        let (k, n) = self.row(j);
+        let (at, cols) = self.run(j);
+        let n = cols.len();
+        let k = at.mid;
         let row = &mut row[..n];
-        let x = Neighbourhood::of(x, k - origin, n, self.stride);
+        let x = Neighbourhood::of(x, at.from(origin), n);
         let b = &b[k..k + n];
         match &self.stencil {
             Stencil::Uniform => {
@@ -325,8 +334,8 @@ impl Level {
             }
             Stencil::Coefficients { diag, east, north } => {
                 let d = &diag[k..k + n];
-                let e = Neighbourhood::of(east, k, n, self.stride);
-                let no = Neighbourhood::of(north, k, n, self.stride);
+                let e = Neighbourhood::of(east, at, n);
+                let no = Neighbourhood::of(north, at, n);
                 for i in 0..n {
                     let ax = d[i] * x.mid[i]
                         - e.mid[i] * x.east[i]
