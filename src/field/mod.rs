@@ -82,7 +82,7 @@ fn join_if<A: Send, B: Send>(
 pub mod solvers {
     pub use super::harmonic::{solve_w, solve_w_for};
     pub use super::laplace::solve_sor;
-    pub use super::multigrid::{set_portable, solve};
+    pub use super::multigrid::{Rows, set_portable, solve, solve_rows};
     pub use super::nested::{MAX_ITERATIONS, Stop};
     pub use super::pose::multigrid::{Dims, Lattice, solve as solve_pose};
 }

@@ -572,14 +572,21 @@ impl<'a> Levels<'a> {
         banded::solve(&neighbours, &rhs, MAX_BAND)
     }
 
-    /// Solves a wide part by multigrid on its bounding box, at the scale `2^scale`.
+    /// Solves a wide part by multigrid on its bounding box, at the scale `2^scale`: on its
+    /// cells and the cells next to them only (see [`multigrid::Rows`]), since the box of a
+    /// part that winds through a map is mostly empty.
     fn solve_wide(&self, cells: &[usize], scale: i32) -> Solved {
         let g = self.grid;
         let (ir, jr) = (g.box_around(cells.iter().copied())).expect("a part has cells");
         let (i0, j0) = (ir.start, jr.start);
-        let sub = g.part(ir, jr);
-        let local = |k: usize| sub.index(k % g.nx - i0, k / g.nx - j0);
-        let mut unknown = vec![false; sub.len()];
+        let in_box = |k: usize| (k % g.nx - i0, k / g.nx - j0);
+        let rows = multigrid::Rows::around(ir.len(), jr.len(), cells.iter().map(|&k| in_box(k)));
+        let local = |k: usize| {
+            let (i, j) = in_box(k);
+            rows.index(i, j)
+                .expect("a part's cells and their neighbours are stored")
+        };
+        let mut unknown = vec![false; rows.len()];
         for &k in cells {
             unknown[local(k)] = true;
         }
@@ -590,7 +597,7 @@ impl<'a> Levels<'a> {
         // and CG, which updates its residual rather than recomputing it, would keep the
         // rounding of a huge first residual. An estimate below [`NO_DIGIT`] of the scale of the
         // solve that made it starts at 0 instead (see there).
-        let mut values = vec![0.0; sub.len()];
+        let mut values = vec![0.0; rows.len()];
         let mut largest: f64 = 0.0;
         for &k in cells {
             for m in self.neighbours(k) {
@@ -607,7 +614,8 @@ impl<'a> Levels<'a> {
                 0.0
             };
         }
-        let stats = multigrid::solve(&sub, &unknown, &mut values, self.tolerance, MAX_ITERATIONS);
+        let stats =
+            multigrid::solve_rows(&rows, &unknown, &mut values, self.tolerance, MAX_ITERATIONS);
         Solved {
             values: cells.iter().map(|&k| values[local(k)]).collect(),
             scale,

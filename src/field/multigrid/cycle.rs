@@ -146,7 +146,7 @@ impl Hierarchy {
     /// The hierarchy of the `nx × ny` grid's `unknown` cells, preconditioning with `cycle`.
     #[cfg(test)]
     pub fn new(nx: usize, ny: usize, unknown: &[bool], cycle: Cycle) -> Self {
-        let fine = Level::finest(nx, ny, unknown);
+        let fine = Level::finest(&super::Rows::whole(nx, ny), unknown);
         let coarse = Coarse::of(&fine);
         Self::on(fine, coarse, cycle)
     }

@@ -8,7 +8,7 @@ use super::Stats;
 use super::cycle::{Hierarchy, split_at};
 use super::kernels::{Neighbourhood, dot, flushed, for_cycle, wide};
 use super::level::Level;
-use crate::field::Grid;
+use super::rows::Rows;
 
 /// The CG vectors on the fine level's layout. The search direction is kept in f32 as
 /// `q = scale · p`, scaled like the cycle's output it is made from (see [`Krylov::iterate`]);
@@ -32,7 +32,7 @@ impl Krylov {
     /// The starting guess (the unknown cells of `values`), the right-hand side `b` (the sum of
     /// each unknown cell's fixed neighbours; cells outside the grid are its ring of zeros) and
     /// the initial residual `r = b − A x`, on the layout of the fine level.
-    pub fn start(fine: &Level, grid: &Grid, unknown: &[bool], values: &[f64]) -> Self {
+    pub fn start(fine: &Level, grid: &Rows, unknown: &[bool], values: &[f64]) -> Self {
         let (nx, ny) = (grid.nx, grid.ny);
         let n = fine.len();
         // `fixed` holds the Dirichlet values and then becomes the residual: fresh memory costs
@@ -40,8 +40,7 @@ impl Krylov {
         let mut x = vec![0.0; n];
         let mut fixed = vec![0.0; n];
         for j in 0..ny {
-            let (k, cols) = fine.stored(j);
-            let row = j * nx + cols.start..j * nx + cols.end;
+            let (k, cols, row) = both(fine, grid, j);
             for (((x, f), v), u) in x[k..k + cols.len()]
                 .iter_mut()
                 .zip(&mut fixed[k..k + cols.len()])
@@ -116,16 +115,16 @@ impl Krylov {
     pub fn true_relative(
         &self,
         fine: &Level,
-        grid: &Grid,
+        grid: &Rows,
         unknown: &[bool],
         values: &[f64],
     ) -> f64 {
         let (nx, ny) = (grid.nx, grid.ny);
-        // A Dirichlet value around cell (i, j) as `start` holds it: 0 on unknown cells and
-        // off the grid.
-        let fixed = |i: usize, j: usize| {
-            let k = j * nx + i;
-            if unknown[k] { 0.0 } else { values[k] }
+        // A Dirichlet value around cell (i, j) as `start` holds it: 0 on unknown cells, on
+        // cells not stored and off the grid.
+        let fixed = |i: usize, j: usize| match grid.index(i, j) {
+            Some(k) if !unknown[k] => values[k],
+            _ => 0.0,
         };
         let mut row = vec![0.0; nx];
         let mut rr = 0.0;
@@ -200,11 +199,9 @@ impl Krylov {
     }
 
     /// Writes the solution into the unknown cells of `values`.
-    pub fn copy_out(&self, fine: &Level, grid: &Grid, unknown: &[bool], values: &mut [f64]) {
-        let nx = grid.nx;
+    pub fn copy_out(&self, fine: &Level, grid: &Rows, unknown: &[bool], values: &mut [f64]) {
         for j in 0..grid.ny {
-            let (k, cols) = fine.stored(j);
-            let row = j * nx + cols.start..j * nx + cols.end;
+            let (k, cols, row) = both(fine, grid, j);
             for ((v, x), u) in values[row.clone()]
                 .iter_mut()
                 .zip(&self.x[k..k + cols.len()])
@@ -342,6 +339,21 @@ impl Krylov {
     }
 }
 
+/// The cells of row `j` that both the fine level and the problem's `rows` store: their index
+/// in the level's vectors, their columns, and their indices in the problem's arrays.
+fn both(fine: &Level, rows: &Rows, j: usize) -> (usize, Range<usize>, Range<usize>) {
+    let (k, cols) = fine.stored(j);
+    let (u, common) = rows.within(j, cols.clone());
+    if common.is_empty() {
+        return (0, 0..0, 0..0);
+    }
+    (
+        k + common.start - cols.start,
+        common.clone(),
+        u..u + common.len(),
+    )
+}
+
 /// `q · A q` on row `j` (`q` starting at index `origin`), with `row` to hold `A q`.
 #[inline(always)]
 fn curvature(level: &Level, (q, origin): (&[f32], usize), j: usize, row: &mut [f64]) -> f64 {
@@ -414,14 +426,9 @@ mod tests {
         }
     }
 
-    /// An `nx × ny` grid of unit cells from the origin.
-    fn unit_grid(nx: usize, ny: usize) -> Grid {
-        Grid {
-            nx,
-            ny,
-            cell: 1.0,
-            origin: [0.0, 0.0],
-        }
+    /// Every cell of an `nx × ny` grid.
+    fn unit_grid(nx: usize, ny: usize) -> Rows {
+        Rows::whole(nx, ny)
     }
 
     /// A ring of unknown cells in a box (rows whose span holds a hole, rows with no unknown

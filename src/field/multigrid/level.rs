@@ -2,6 +2,7 @@
 //! rows, and how the next coarser level is made from it (Galerkin coarsening).
 
 use super::kernels::At;
+use super::rows::Rows;
 
 /// Factor on the Galerkin coarse operators (see [`Level::coarsen`]).
 const COARSE_SCALE: f32 = 0.5;
@@ -103,16 +104,21 @@ impl Layout {
     }
 }
 
-/// [`Level::spans`] of a level `nx` wide and `ny` high with the given active cells.
-fn spans(nx: usize, ny: usize, active: impl Fn(usize, usize) -> bool) -> Vec<[usize; 2]> {
-    (0..ny.div_ceil(2))
+/// [`Level::spans`] of the finest level of a problem stored in `rows` with its `unknown` cells.
+fn spans(rows: &Rows, unknown: &[bool]) -> Vec<[usize; 2]> {
+    (0..rows.ny.div_ceil(2))
         .map(|p| {
-            let rows = 2 * p..(2 * p + 2).min(ny);
-            let lo = rows
-                .clone()
-                .filter_map(|j| (0..nx).find(|&i| active(i, j)))
+            let pair = 2 * p..(2 * p + 2).min(rows.ny);
+            let row = |j: usize| {
+                let (k, cols) = rows.row(j);
+                (cols.start, &unknown[k..k + cols.len()])
+            };
+            let lo = (pair.clone().map(row))
+                .filter_map(|(first, u)| u.iter().position(|u| *u).map(|i| first + i))
                 .min();
-            let hi = rows.filter_map(|j| (0..nx).rfind(|&i| active(i, j))).max();
+            let hi = (pair.map(row))
+                .filter_map(|(first, u)| u.iter().rposition(|u| *u).map(|i| first + i))
+                .max();
             match (lo, hi) {
                 (Some(lo), Some(hi)) => [lo / 2 * 2, hi + 1],
                 _ => [0, 0],
@@ -203,20 +209,24 @@ impl Level {
         (k, cells)
     }
 
-    /// The fine level of the `grid`'s `unknown` cells.
-    pub fn finest(nx: usize, ny: usize, unknown: &[bool]) -> Self {
-        let spans = spans(nx, ny, |i, j| unknown[j * nx + i]);
+    /// The fine level of a problem stored in `rows` with its `unknown` cells (in the order of
+    /// `rows`).
+    pub fn finest(rows: &Rows, unknown: &[bool]) -> Self {
+        let (nx, ny) = (rows.nx, rows.ny);
+        let spans = spans(rows, unknown);
         let layout = Layout::new(nx, ny, &spans);
         let mut inv_diag = vec![0.0; layout.start[ny + 2] + 2];
         for j in 0..ny {
             let [lo, hi] = spans[j / 2];
             let cols = lo..hi;
-            if cols.is_empty() {
+            // The span's cells that `rows` stores (every unknown cell among them).
+            let (u, stored) = rows.within(j, cols);
+            if stored.is_empty() {
                 continue;
             }
-            let k = layout.at(cols.start + 1, j + 1);
-            let row = &unknown[j * nx + cols.start..j * nx + cols.end];
-            for (inv, u) in inv_diag[k..k + cols.len()].iter_mut().zip(row) {
+            let k = layout.at(stored.start + 1, j + 1);
+            let row = &unknown[u..u + stored.len()];
+            for (inv, u) in inv_diag[k..k + stored.len()].iter_mut().zip(row) {
                 *inv = if *u { 0.25 } else { 0.0 };
             }
         }
@@ -374,7 +384,7 @@ mod tests {
             band && !(120..126).contains(&j)
         };
         let unknown: Vec<bool> = (0..nx * ny).map(|k| inside(k % nx, k / nx)).collect();
-        let mut level = Level::finest(nx, ny, &unknown);
+        let mut level = Level::finest(&Rows::whole(nx, ny), &unknown);
         assert!(
             10 * level.len() < (nx + 2) * (ny + 3),
             "{} stored",
