@@ -17,7 +17,8 @@
 //!    values, scaled so that the largest is about 1, and `W = 0` at the *cut* (the pending
 //!    cells beyond the band): a lower bound of the true `W`, exact at the accepted cells and
 //!    close to it away from the cut. A narrow part (a stretch of corridor) is solved directly
-//!    (`banded.rs`, accurate cell by cell), a wide one by multigrid on its bounding box;
+//!    (`banded.rs`, accurate cell by cell), a wide one by multigrid on its cells and their
+//!    neighbours, row by row (its bounding box can be mostly empty);
 //! 3. accepts the cells of the part that the solve resolves (at least `τ` of its scale), that
 //!    are more than [`MARGIN`] steps from the cut and at least [`GAP`] times the values near it,
 //!    stored with the exponent of the part's scale ([`ScaledW`]).
@@ -526,8 +527,8 @@ impl<'a> Levels<'a> {
 
     /// Solves part `index` of the band (its cells are in the order of their slots), with the
     /// accepted cells around it as Dirichlet values and 0 at the cut, at the scale `2^e` of its
-    /// largest accepted neighbour: directly when it is narrow, else by multigrid on its bounding
-    /// box. Reads only `self`.
+    /// largest accepted neighbour: directly when it is narrow, else by multigrid (see
+    /// [`Levels::solve_wide`]). Reads only `self`.
     fn solve_part(&self, index: u32, Part { cells, wide }: &Part) -> Solved {
         let scale = cells
             .iter()
