@@ -122,23 +122,37 @@ impl Krylov {
         let (nx, ny) = (grid.nx, grid.ny);
         // A Dirichlet value around cell (i, j) as `start` holds it: 0 on unknown cells, on
         // cells not stored and off the grid.
-        let fixed = |i: usize, j: usize| match grid.index(i, j) {
-            Some(k) if !unknown[k] => values[k],
-            _ => 0.0,
+        // A Dirichlet value of a row (its stored columns from index `k`) at column `i`, as
+        // `start` holds it: 0 on unknown cells, on cells not stored and off the grid.
+        let fixed = |(k, cols): &(usize, Range<usize>), i: usize| {
+            if cols.contains(&i) {
+                let m = k + i - cols.start;
+                if unknown[m] { 0.0 } else { values[m] }
+            } else {
+                0.0
+            }
         };
+        let none = (0, 0..0);
         let mut row = vec![0.0; nx];
         let mut rr = 0.0;
         for j in 0..ny {
             let (at, cols) = fine.run(j);
             let u = Neighbourhood::of(&self.x, at, cols.len());
             let d = &fine.inv_diag[at.mid..at.mid + cols.len()];
+            let here = grid.row(j);
+            let above = if j + 1 < ny {
+                grid.row(j + 1)
+            } else {
+                none.clone()
+            };
+            let below = if j > 0 { grid.row(j - 1) } else { none.clone() };
             for (l, i) in cols.clone().enumerate() {
                 if d[l] != 0.0 {
                     let f = [
-                        if i > 0 { fixed(i - 1, j) } else { 0.0 },
-                        if i + 1 < nx { fixed(i + 1, j) } else { 0.0 },
-                        if j + 1 < ny { fixed(i, j + 1) } else { 0.0 },
-                        if j > 0 { fixed(i, j - 1) } else { 0.0 },
+                        if i > 0 { fixed(&here, i - 1) } else { 0.0 },
+                        fixed(&here, i + 1),
+                        fixed(&above, i),
+                        fixed(&below, i),
                     ];
                     let u = [u.mid[l], u.west[l], u.east[l], u.up[l], u.down[l]];
                     row[i] = residual_at(f, u).1;

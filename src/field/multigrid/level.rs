@@ -247,6 +247,51 @@ impl Level {
         if self.inv_diag[k] != 0.0 { 1.0 } else { 0.0 }
     }
 
+    /// Padded row `r`'s values of the level vector `v` over the padded columns `cols`, 0 where
+    /// the row stores none (or where there is no such row), into `out`.
+    fn row_of(&self, v: &[f32], r: usize, cols: std::ops::Range<usize>, out: &mut Vec<f32>) {
+        out.clear();
+        out.resize(cols.len(), 0.0);
+        let Some(&first) = self.layout.first.get(r) else {
+            return;
+        };
+        let end = first + self.layout.start[r + 1] - self.layout.start[r];
+        let (lo, hi) = (cols.start.max(first), cols.end.min(end));
+        if lo < hi {
+            let k = self.layout.start[r] + lo - first;
+            out[lo - cols.start..hi - cols.start].copy_from_slice(&v[k..k + hi - lo]);
+        }
+    }
+
+    /// The diagonals, east couplings and north couplings of padded row `r` over the padded
+    /// columns `cols` (what [`Level::diag_at`], [`Level::east_at`] and [`Level::north_at`]
+    /// give), into `[diag, east, north]`: what [`Level::coarsen`] sums, a row at a time.
+    fn stencil_of_row(&self, r: usize, cols: std::ops::Range<usize>, out: &mut [Vec<f32>; 3]) {
+        let [d, e, n] = out;
+        match &self.stencil {
+            Stencil::Coefficients { diag, east, north } => {
+                self.row_of(diag, r, cols.clone(), d);
+                self.row_of(east, r, cols.clone(), e);
+                self.row_of(north, r, cols, n);
+            }
+            Stencil::Uniform => {
+                // Whether each cell is active, and its east and north neighbours.
+                let width = cols.len();
+                self.row_of(&self.inv_diag, r, cols.start..cols.end + 1, d);
+                self.row_of(&self.inv_diag, r + 1, cols, n);
+                let active = |v: f32| if v != 0.0 { 1.0 } else { 0.0 };
+                e.clear();
+                for i in 0..width {
+                    let (here, east, north) = (active(d[i]), active(d[i + 1]), active(n[i]));
+                    e.push(here * east);
+                    n[i] = here * north;
+                    d[i] = 4.0 * here;
+                }
+                d.truncate(width);
+            }
+        }
+    }
+
     /// The diagonal at padded `(c, r)` (0 where not stored).
     fn diag_padded(&self, c: usize, r: usize) -> f32 {
         let Some(k) = self.layout.stored(c, r) else {
@@ -330,26 +375,30 @@ impl Level {
         let layout = Layout::new(nx, ny, &spans);
         let n = layout.start[ny + 2] + 2;
         let (mut diag, mut east, mut north) = (vec![0.0f32; n], vec![0.0; n], vec![0.0; n]);
+        // The stencils of the pair's two fine rows over the children's columns.
+        let mut pair = [[(); 3].map(|_| Vec::new()), [(); 3].map(|_| Vec::new())];
         for j in 0..ny {
-            for i in parents(j) {
-                let c = layout.at(i + 1, j + 1);
-                // Children, in padded coordinates: a (2I, 2J), b (2I+1, 2J), d (2I, 2J+1),
-                // e (2I+1, 2J+1).
-                let (a, r) = (2 * i + 1, 2 * j + 1);
-                let (b, up) = (a + 1, r + 1);
-                let inside = self.east_padded(a, r)
-                    + self.east_padded(a, up)
-                    + self.north_padded(a, r)
-                    + self.north_padded(b, r);
-                let sum = self.diag_padded(a, r)
-                    + self.diag_padded(b, r)
-                    + self.diag_padded(a, up)
-                    + self.diag_padded(b, up);
+            let cols = parents(j);
+            if cols.is_empty() {
+                continue;
+            }
+            // Children, in padded coordinates: a (2I, 2J), b (2I+1, 2J) in row r, d (2I, 2J+1),
+            // e (2I+1, 2J+1) in the row above; at a = 2t and b = 2t + 1 of the buffers.
+            let children = 2 * cols.start + 1..2 * cols.end + 1;
+            for (q, buffers) in pair.iter_mut().enumerate() {
+                self.stencil_of_row(2 * j + 1 + q, children.clone(), buffers);
+            }
+            let [[d0, e0, n0], [d1, e1, n1]] = &pair;
+            let c0 = layout.at(cols.start + 1, j + 1);
+            for t in 0..cols.len() {
+                let (a, b, c) = (2 * t, 2 * t + 1, c0 + t);
+                let inside = e0[a] + e1[a] + n0[a] + n0[b];
+                let sum = d0[a] + d0[b] + d1[a] + d1[b];
                 // Piecewise-constant transfers make R A P twice the rediscretized 2h stencil,
                 // which under-corrects smooth errors; the factor restores its size.
                 diag[c] = COARSE_SCALE * (sum - 2.0 * inside);
-                east[c] = COARSE_SCALE * (self.east_padded(b, r) + self.east_padded(b, up));
-                north[c] = COARSE_SCALE * (self.north_padded(a, up) + self.north_padded(b, up));
+                east[c] = COARSE_SCALE * (e0[b] + e1[b]);
+                north[c] = COARSE_SCALE * (n1[a] + n1[b]);
             }
         }
         let inv_diag: Vec<f32> = diag
