@@ -120,8 +120,6 @@ impl Krylov {
         values: &[f64],
     ) -> f64 {
         let (nx, ny) = (grid.nx, grid.ny);
-        // A Dirichlet value around cell (i, j) as `start` holds it: 0 on unknown cells, on
-        // cells not stored and off the grid.
         // A Dirichlet value of a row (its stored columns from index `k`) at column `i`, as
         // `start` holds it: 0 on unknown cells, on cells not stored and off the grid.
         let fixed = |(k, cols): &(usize, Range<usize>), i: usize| {

@@ -26,9 +26,10 @@ pub enum Stencil {
 
 /// One level of the hierarchy: a grid with a ring of inactive cells around it and a 5-point
 /// stencil, stored ragged: each row holds only the columns that the passes over it and over
-/// the rows beside it read (its span and theirs, a little wider: see [`Layout::new`]), one
-/// row after another. A nested part's box can be mostly empty (the rooms map's: 5.5 times its rows'
-/// spans), and its vectors, its stencil and their setup then cost the spans, not the box.
+/// the rows beside it read (its span and theirs, a cell wider: see [`Layout::new`]), one row
+/// after another. A nested part's box can be mostly empty (the rooms map's: 5.5 times its
+/// rows' spans), and its vectors, its stencil and their setup then cost the spans, not the
+/// box.
 /// Inactive cells have `inv_diag = 0` and no coupling, so every sweep can run over a row's
 /// span without branches, and the vectors a level works on hold 0 there. Each row is
 /// processed only over its span ([`Level::span`]), outside which every cell is inactive.
@@ -66,9 +67,8 @@ struct Layout {
 impl Layout {
     /// The layout of a level `nx` wide and `ny` high whose pairs of rows have `spans`: padded
     /// row `r` stores the spans of the grid's rows `r − 2`, `r − 1` and `r` (the rows whose
-    /// passes read it), each widened by a cell to the west (a cell's west neighbour) and two
-    /// to the east (its east neighbour, and that one's own east, which [`Level::coarsen`]
-    /// reads), within the ring.
+    /// passes read it), each widened by a cell each way (a cell's west and east neighbours),
+    /// within the ring.
     fn new(nx: usize, ny: usize, spans: &[[usize; 2]]) -> Self {
         let rows = ny + 2;
         let (mut first, mut start) = (Vec::with_capacity(rows), Vec::with_capacity(rows + 1));
@@ -79,8 +79,8 @@ impl Layout {
             let (lo, hi) = read_by
                 .map(|j| spans[j / 2])
                 .filter(|[lo, hi]| lo < hi)
-                // Cells `lo − 1 .. hi + 2`: padded columns `lo .. hi + 3`.
-                .map(|[lo, hi]| (lo, (hi + 3).min(nx + 2)))
+                // Cells `lo − 1 .. hi + 1`: padded columns `lo .. hi + 2`.
+                .map(|[lo, hi]| (lo, (hi + 2).min(nx + 2)))
                 .fold((usize::MAX, 0), |(a, b), (lo, hi)| (a.min(lo), b.max(hi)));
             let (lo, hi) = if lo < hi { (lo, hi) } else { (0, 0) };
             first.push(lo);
@@ -447,14 +447,8 @@ mod tests {
             for j in 0..level.ny {
                 for i in level.span(j) {
                     let (i, j) = (i as isize, j as isize);
-                    let reads = [(i - 1, j), (i, j), (i + 1, j), (i + 2, j), (i, j - 1)];
-                    // Within the ring (beyond it, `Level::east_at` reads 0).
-                    let ring = level.nx as isize;
-                    for (a, b) in reads
-                        .into_iter()
-                        .chain([(i, j + 1)])
-                        .filter(|c| c.0 <= ring)
-                    {
+                    let reads = [(i - 1, j), (i, j), (i + 1, j), (i, j - 1), (i, j + 1)];
+                    for (a, b) in reads {
                         assert!(stored(a, b), "({a}, {b}) around ({i}, {j})");
                     }
                     let k = level.pad(i as usize, j as usize);
