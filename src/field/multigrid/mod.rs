@@ -23,19 +23,22 @@
 //! sees comes near f32's range limits: a field decaying through a maze would otherwise fill the
 //! deep rooms with subnormals, which the processor computes on a slow path.
 //!
-//! The parts: `level.rs` (a level's layout and stencil, and Galerkin coarsening), `smoother.rs`
-//! (red-black Gauss-Seidel as a wavefront, the residual), `cycle.rs` (the hierarchy and the
-//! W-cycle, the exact coarsest solve), `krylov.rs` (the CG driver), `kernels.rs` (the AVX2
-//! trampoline and its inlining rule, the 5-point neighbourhood, reductions).
+//! The parts: `rows.rs` (where a problem's cells are stored), `level.rs` (a level's ragged
+//! layout and stencil, and Galerkin coarsening), `smoother.rs` (red-black Gauss-Seidel as a
+//! wavefront, the residual), `cycle.rs` (the hierarchy and the W-cycle, the exact coarsest
+//! solve), `krylov.rs` (the CG driver), `kernels.rs` (the AVX2 trampoline and its inlining
+//! rule, the 5-point neighbourhood, reductions).
 //!
 //! Where the time goes, and what is done about it: each level's smoothing passes and its
 //! residual restriction (or its prolongation and smoothing passes) run as one wavefront over the
 //! rows, so a level is read from memory once per half-cycle rather than once per pass; every
 //! row loop is straight-line code that the compiler vectorizes, built for AVX2 when the
-//! processor has it (`wide`), and goes over only the row's span of active cells (a nested
-//! solve's bounding box can be half empty); a cycle starts from zero without clearing its
-//! vectors (its first pass reads nothing of them), and it sums `z · r` in its last pass, while
-//! each row is still in cache; and each CG iteration makes two passes over its vectors besides
+//! processor has it (`wide`), and goes over only the row's span of active cells, and each level
+//! stores only those spans and their neighbours, row after row (`level.rs`), as a nested part's
+//! problem stores only its cells and theirs (`rows.rs`): a part's bounding box can be five
+//! times its cells, and memory first touched costs more than the arithmetic on it; a cycle
+//! starts from zero without clearing its vectors (its first pass reads nothing of them), and it
+//! sums `z · r` in its last pass, while each row is still in cache; and each CG iteration makes two passes over its vectors besides
 //! the cycle (`Krylov`): one makes the new search direction and its curvature `p · A p`, the
 //! other updates the solution and the residual. The search direction is kept in f32, scaled
 //! like the cycle's output it is made from, and `A p` is recomputed from it rather than stored:
