@@ -573,9 +573,9 @@ impl<'a> Levels<'a> {
         banded::solve(&neighbours, &rhs, MAX_BAND)
     }
 
-    /// Solves a wide part by multigrid on its bounding box, at the scale `2^scale`: on its
-    /// cells and the cells next to them only (see [`multigrid::Rows`]), since the box of a
-    /// part that winds through a map is mostly empty.
+    /// Solves a wide part by multigrid at the scale `2^scale`, on its cells and the cells next
+    /// to them only (see [`multigrid::Rows`]): the bounding box of a part that winds through
+    /// a map is mostly empty.
     fn solve_wide(&self, cells: &[usize], scale: i32) -> Solved {
         let g = self.grid;
         let (ir, jr) = (g.box_around(cells.iter().copied())).expect("a part has cells");
@@ -592,7 +592,7 @@ impl<'a> Levels<'a> {
             unknown[local(k)] = true;
         }
         // The accepted cells around the part at its scale; 0 everywhere else (blocked cells,
-        // the pending cells beyond the cut, and cells of the box that do not touch the part);
+        // the pending cells beyond the cut, and stored cells that do not touch the part);
         // the part's own estimates as the starting guess, within the bounds of the solution
         // (the values around it): an estimate made at a larger scale can be far above them,
         // and CG, which updates its residual rather than recomputing it, would keep the

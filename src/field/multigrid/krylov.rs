@@ -29,18 +29,19 @@ pub struct Krylov {
 }
 
 impl Krylov {
-    /// The starting guess (the unknown cells of `values`), the right-hand side `b` (the sum of
-    /// each unknown cell's fixed neighbours; cells outside the grid are its ring of zeros) and
-    /// the initial residual `r = b − A x`, on the layout of the fine level.
-    pub fn start(fine: &Level, grid: &Rows, unknown: &[bool], values: &[f64]) -> Self {
-        let (nx, ny) = (grid.nx, grid.ny);
+    /// The starting guess (the unknown cells of `values`, both stored as `problem` says), the
+    /// right-hand side `b` (the sum of each unknown cell's fixed neighbours; cells `problem`
+    /// does not store and cells outside the grid count as 0) and the initial residual
+    /// `r = b − A x`, on the layout of the fine level.
+    pub fn start(fine: &Level, problem: &Rows, unknown: &[bool], values: &[f64]) -> Self {
+        let (nx, ny) = (problem.nx, problem.ny);
         let n = fine.len();
         // `fixed` holds the Dirichlet values and then becomes the residual: fresh memory costs
         // page faults. The level stores every cell next to an active one (see `level.rs`).
         let mut x = vec![0.0; n];
         let mut fixed = vec![0.0; n];
         for j in 0..ny {
-            let (k, cols, row) = both(fine, grid, j);
+            let (k, cols, row) = both(fine, problem, j);
             for (((x, f), v), u) in x[k..k + cols.len()]
                 .iter_mut()
                 .zip(&mut fixed[k..k + cols.len()])
@@ -115,11 +116,11 @@ impl Krylov {
     pub fn true_relative(
         &self,
         fine: &Level,
-        grid: &Rows,
+        problem: &Rows,
         unknown: &[bool],
         values: &[f64],
     ) -> f64 {
-        let (nx, ny) = (grid.nx, grid.ny);
+        let (nx, ny) = (problem.nx, problem.ny);
         // A Dirichlet value of a row (its stored columns from index `k`) at column `i`, as
         // `start` holds it: 0 on unknown cells, on cells not stored and off the grid.
         let fixed = |(k, cols): &(usize, Range<usize>), i: usize| {
@@ -137,13 +138,17 @@ impl Krylov {
             let (at, cols) = fine.run(j);
             let u = Neighbourhood::of(&self.x, at, cols.len());
             let d = &fine.inv_diag[at.mid..at.mid + cols.len()];
-            let here = grid.row(j);
+            let here = problem.row(j);
             let above = if j + 1 < ny {
-                grid.row(j + 1)
+                problem.row(j + 1)
             } else {
                 none.clone()
             };
-            let below = if j > 0 { grid.row(j - 1) } else { none.clone() };
+            let below = if j > 0 {
+                problem.row(j - 1)
+            } else {
+                none.clone()
+            };
             for (l, i) in cols.clone().enumerate() {
                 if d[l] != 0.0 {
                     let f = [
@@ -211,9 +216,9 @@ impl Krylov {
     }
 
     /// Writes the solution into the unknown cells of `values`.
-    pub fn copy_out(&self, fine: &Level, grid: &Rows, unknown: &[bool], values: &mut [f64]) {
-        for j in 0..grid.ny {
-            let (k, cols, row) = both(fine, grid, j);
+    pub fn copy_out(&self, fine: &Level, problem: &Rows, unknown: &[bool], values: &mut [f64]) {
+        for j in 0..problem.ny {
+            let (k, cols, row) = both(fine, problem, j);
             for ((v, x), u) in values[row.clone()]
                 .iter_mut()
                 .zip(&self.x[k..k + cols.len()])

@@ -292,9 +292,9 @@ impl Level {
         }
     }
 
-    /// The diagonal at padded `(c, r)` (0 where not stored).
-    fn diag_padded(&self, c: usize, r: usize) -> f32 {
-        let Some(k) = self.layout.stored(c, r) else {
+    /// The diagonal at cell `(i, j)` (0 where not stored).
+    pub fn diag_at(&self, i: usize, j: usize) -> f32 {
+        let Some(k) = self.layout.stored(i + 1, j + 1) else {
             return 0.0;
         };
         match &self.stencil {
@@ -303,47 +303,32 @@ impl Level {
         }
     }
 
-    /// The coupling of the cell at padded `(c, r)` to its east neighbour (0 where not stored).
-    fn east_padded(&self, c: usize, r: usize) -> f32 {
-        let Some(k) = self.layout.stored(c, r) else {
+    /// The coupling of cell `(i, j)` to its east neighbour (0 where not stored).
+    pub fn east_at(&self, i: usize, j: usize) -> f32 {
+        let Some(k) = self.layout.stored(i + 1, j + 1) else {
             return 0.0;
         };
         match &self.stencil {
             Stencil::Uniform => {
-                let east = self.layout.stored(c + 1, r).map_or(0.0, |m| self.active(m));
+                let east = (self.layout.stored(i + 2, j + 1)).map_or(0.0, |m| self.active(m));
                 self.active(k) * east
             }
             Stencil::Coefficients { east, .. } => east[k],
         }
     }
 
-    /// The coupling of the cell at padded `(c, r)` to its north neighbour (0 where not stored).
-    fn north_padded(&self, c: usize, r: usize) -> f32 {
-        let Some(k) = self.layout.stored(c, r) else {
+    /// The coupling of cell `(i, j)` to its north neighbour (0 where not stored).
+    pub fn north_at(&self, i: usize, j: usize) -> f32 {
+        let Some(k) = self.layout.stored(i + 1, j + 1) else {
             return 0.0;
         };
         match &self.stencil {
             Stencil::Uniform => {
-                let north = self.layout.stored(c, r + 1).map_or(0.0, |m| self.active(m));
+                let north = (self.layout.stored(i + 1, j + 2)).map_or(0.0, |m| self.active(m));
                 self.active(k) * north
             }
             Stencil::Coefficients { north, .. } => north[k],
         }
-    }
-
-    /// The diagonal at cell `(i, j)`.
-    pub fn diag_at(&self, i: usize, j: usize) -> f32 {
-        self.diag_padded(i + 1, j + 1)
-    }
-
-    /// East coupling of cell `(i, j)`.
-    pub fn east_at(&self, i: usize, j: usize) -> f32 {
-        self.east_padded(i + 1, j + 1)
-    }
-
-    /// North coupling of cell `(i, j)`.
-    pub fn north_at(&self, i: usize, j: usize) -> f32 {
-        self.north_padded(i + 1, j + 1)
     }
 
     /// The Galerkin coarse level `R A P` for piecewise-constant `P` (coarse cell `(I, J)` owns
