@@ -102,6 +102,12 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         field.iterations,
         field.relative_residual
     );
+    if field.first_cells < counts.reachable {
+        say!(
+            "first solve: on the {} unknown cells of a box around the target",
+            field.first_cells
+        );
+    }
     if field.nested.levels > 0 {
         say!(
             "nested: {} level(s), {} cells solved in {} part(s)",

@@ -1,5 +1,6 @@
 //! An agent's harmonic field ([`HarmonicField`]) and its production solve of `W = 1 − V`
-//! ([`solve_w`]): multigrid-preconditioned CG (`multigrid/`) over the whole grid, then the
+//! ([`solve_w`]): multigrid-preconditioned CG (`multigrid/`) over the whole grid (on a large
+//! map, over a box around the target when that resolves as much: see [`FIRST_BOX`]), then the
 //! nested levels below what that resolves (`nested.rs`).
 //!
 //! A solve to a relative residual of 1e-10 gives `W` to about 1e-12 absolute. Behind a few
@@ -18,7 +19,9 @@ use nalgebra::Vector2;
 use super::grid::Grid;
 use super::mask::CellCounts;
 use super::multigrid;
-use super::nested::{DEPTH_STEP, LevelStats, MAX_ITERATIONS, Stop, deep_cells, solve_levels};
+use super::nested::{
+    DEPTH_STEP, LevelStats, MAX_ITERATIONS, Stop, cut_from_the_rest, deep_cells, solve_levels,
+};
 use super::scaled::{ScaledW, ldexp};
 use super::window::{Reach, Window};
 use super::{Disc, FieldError, FreeSpace, KnownMap, Sampler, Streamline};
@@ -51,6 +54,9 @@ pub struct HarmonicField {
     pub iterations: usize,
     /// Solves: the first plus the nested ones for the deep regions (see [`solve_w`]).
     pub solves: usize,
+    /// The unknown cells of the first solve: every reachable cell, or on a large map those of
+    /// a box around the target (both, when the box was too small: see [`solve_w`]).
+    pub first_cells: usize,
     /// The nested levels below the first solve.
     pub nested: LevelStats,
     /// The worst final relative residual of the solves.
@@ -157,6 +163,7 @@ impl HarmonicField {
             target_radius: agent.target_disc(),
             iterations: solution.iterations,
             solves: solution.solves,
+            first_cells: solution.first_cells,
             nested: solution.nested,
             relative_residual: solution.relative_residual,
             solve_time: started.elapsed(),
@@ -433,6 +440,8 @@ pub struct HarmonicSolution {
     pub iterations: usize,
     /// Solves: the first one plus the nested ones.
     pub solves: usize,
+    /// The unknown cells of the first solve (see [`HarmonicField::first_cells`]).
+    pub first_cells: usize,
     /// The worst final relative residual of the solves.
     pub relative_residual: f64,
     /// The nested levels (see `nested.rs`).
@@ -441,7 +450,8 @@ pub struct HarmonicSolution {
 
 /// Solves for `W` on the `reachable` cells with `W = 1` on the `target` cells (the target
 /// disc), each solve to a relative residual of `tolerance`: the first solve over the whole
-/// grid, then the nested levels below what it resolves. `warm` is a previous `W` on the same
+/// grid (on a map of 16 boxes 512 cells wide or more, over one around the target when that
+/// resolves as much), then the nested levels below what it resolves. `warm` is a previous `W` on the same
 /// grid to start the first solve from (after a small change of the world), if any.
 pub fn solve_w(
     grid: &Grid,
@@ -479,17 +489,114 @@ pub fn solve_w_for(
     for &t in target {
         w[t] = 1.0;
     }
-    let first = multigrid::solve(grid, &unknown, &mut w, tolerance, MAX_ITERATIONS);
-    let pending = deep_cells(grid, &unknown, &w, DEPTH_STEP);
+    let boxed = (warm.is_none())
+        .then(|| first_box(grid, &unknown, target, FIRST_BOX))
+        .flatten();
+    let (first, pending) = first_solve(grid, (&unknown, boxed.as_deref()), &mut w, tolerance);
     let mut w = ScaledW::from_plain(w);
     let nested = solve_levels(grid, pending, &mut w, tolerance, stop);
     HarmonicSolution {
         w,
         iterations: first.iterations + nested.iterations,
-        solves: 1 + nested.solves,
+        solves: first.solves + nested.solves,
+        first_cells: first.cells,
         relative_residual: first.relative_residual.max(nested.relative_residual),
         nested,
     }
+}
+
+/// The side of the box, in cells, that a large map's first solve is made on (see
+/// [`first_box`]).
+pub const FIRST_BOX: usize = 512;
+
+/// The unknown cells of the box `side` ([`FIRST_BOX`]) cells wider than the `target` cells,
+/// when the grid has at least 16 times its cells and unknown cells beyond it. The first solve resolves
+/// `W` to [`DEPTH_STEP`] only: on a map of rooms that is a few rooms around the target (on the
+/// Moving AI rooms map's 2560² grid, 1 153 of its 4.58 M cells; `W` falls below 1e-44 within
+/// 256 cells of the target there), and the nested levels solve the rest again band by band.
+/// So the first solve is made on a box, which costs a sixteenth of the grid at most, and on
+/// the whole grid only when the box turns out too small for the field (see [`first_solve`]).
+/// A room, whose field is shallow everywhere, is smaller than sixteen boxes and is solved
+/// whole at once.
+fn first_box(grid: &Grid, unknown: &[bool], target: &[usize], side: usize) -> Option<Vec<bool>> {
+    if grid.len() / 16 < side * side {
+        return None;
+    }
+    let (i, j) = grid.box_around(target.iter().copied())?;
+    let half = side / 2;
+    let i = i.start.saturating_sub(half)..(i.end + half).min(grid.nx);
+    let j = j.start.saturating_sub(half)..(j.end + half).min(grid.ny);
+    let mut boxed = vec![false; grid.len()];
+    let mut beyond = false;
+    for (k, &u) in unknown.iter().enumerate() {
+        let inside = i.contains(&(k % grid.nx)) && j.contains(&(k / grid.nx));
+        boxed[k] = u && inside;
+        beyond |= u && !inside;
+    }
+    beyond.then_some(boxed)
+}
+
+/// How the first solve went: its CG iterations and final residual, how many solves it took
+/// (two when a box was too small) and their unknown cells.
+struct FirstSolve {
+    iterations: usize,
+    relative_residual: f64,
+    solves: usize,
+    cells: usize,
+}
+
+/// The first solve of `w` on the `unknown` cells (from `w` as it is), and the cells it leaves
+/// pending for the nested levels: those below [`DEPTH_STEP`] ([`deep_cells`]). With `boxed`
+/// (see [`first_box`]), it is made on those cells first, the others held at 0, and the cells
+/// the cut may have changed are pending too; if the cut kept a cell above the depth from being
+/// accepted, the box was too small, and the solve is made again on every cell from the start,
+/// as without a box.
+fn first_solve(
+    grid: &Grid,
+    (unknown, boxed): (&[bool], Option<&[bool]>),
+    w: &mut [f64],
+    tolerance: f64,
+) -> (FirstSolve, Vec<bool>) {
+    let mut tried = FirstSolve {
+        iterations: 0,
+        relative_residual: 0.0,
+        solves: 0,
+        cells: 0,
+    };
+    let count = |cells: &[bool]| cells.iter().filter(|&&u| u).count();
+    if let Some(boxed) = boxed {
+        let start: Vec<f64> = (0..w.len()).filter(|&k| boxed[k]).map(|k| w[k]).collect();
+        let stats = multigrid::solve(grid, boxed, w, tolerance, MAX_ITERATIONS);
+        let converged = stats.relative_residual <= tolerance;
+        let mut pending = deep_cells(grid, unknown, w, DEPTH_STEP);
+        if converged && cut_from_the_rest(grid, (unknown, boxed), w, &mut pending) {
+            let first = FirstSolve {
+                iterations: stats.iterations,
+                relative_residual: stats.relative_residual,
+                solves: 1,
+                cells: count(boxed),
+            };
+            return (first, pending);
+        }
+        // Too small: from the start again, on every cell.
+        for (k, v) in (0..w.len()).filter(|&k| boxed[k]).zip(start) {
+            w[k] = v;
+        }
+        tried = FirstSolve {
+            iterations: stats.iterations,
+            relative_residual: 0.0,
+            solves: 1,
+            cells: count(boxed),
+        };
+    }
+    let stats = multigrid::solve(grid, unknown, w, tolerance, MAX_ITERATIONS);
+    let first = FirstSolve {
+        iterations: tried.iterations + stats.iterations,
+        relative_residual: stats.relative_residual,
+        solves: tried.solves + 1,
+        cells: tried.cells + count(unknown),
+    };
+    (first, deep_cells(grid, unknown, w, DEPTH_STEP))
 }
 
 /// The field with `W = 1` on the one free cell `target` of the `blocked` mask, to 1e-12: the
@@ -555,6 +662,79 @@ mod tests {
         for (i, deep) in deep.iter().enumerate() {
             assert_eq!(*deep, i >= 5 + REACH && i != 20, "cell {i}");
         }
+    }
+
+    /// The unknown cells and `W`'s start (1 on the target cells) of the field of `target` on
+    /// the free cells of `blocked`.
+    fn start_of(grid: &Grid, blocked: &[bool], target: (usize, usize)) -> (Vec<bool>, Vec<f64>) {
+        let mut unknown = crate::field::laplace::reachable_from(grid, blocked, target);
+        let t = grid.index(target.0, target.1);
+        unknown[t] = false;
+        let mut w = vec![0.0; grid.len()];
+        w[t] = 1.0;
+        (unknown, w)
+    }
+
+    /// `W` solved to 1e-12 after a first solve on `boxed` cells, or on every cell.
+    fn solved_after(
+        grid: &Grid,
+        (unknown, w): (&[bool], &[f64]),
+        boxed: Option<&[bool]>,
+    ) -> (FirstSolve, ScaledW) {
+        let mut w = w.to_vec();
+        let (first, pending) = first_solve(grid, (unknown, boxed), &mut w, 1e-12);
+        let mut w = ScaledW::from_plain(w);
+        solve_levels(grid, pending, &mut w, 1e-12, &Stop::Never);
+        (first, w)
+    }
+
+    /// A corridor three cells wide and 398 long in a grid of 400 × 400 (the rest blocked):
+    /// `W` falls by about half per cell, to 1e-120 at its end. Its first solve on a box 96
+    /// cells wide around the target (a sixteenth of the grid) resolves what the solve on every
+    /// cell does (`W` at the box's edge is below 1e-13), and with the nested levels every cell
+    /// gets the same `W` to six digits.
+    #[test]
+    fn a_first_solve_on_a_box_gives_the_field_of_one_on_every_cell() {
+        let grid = Grid::covering([40.0, 40.0], 0.1);
+        assert_eq!(grid.len(), 160_000);
+        let blocked: Vec<bool> = (0..grid.len())
+            .map(|k| !((1..399).contains(&(k % grid.nx)) && (1..4).contains(&(k / grid.nx))))
+            .collect();
+        let (unknown, w) = start_of(&grid, &blocked, (1, 2));
+        let boxed = first_box(&grid, &unknown, &[grid.index(1, 2)], 96).expect("a box");
+        assert!(boxed.iter().filter(|b| **b).count() < 200);
+        let (first, on_box) = solved_after(&grid, (&unknown, &w), Some(&boxed));
+        assert_eq!(first.solves, 1, "the box was enough");
+        let (_, whole) = solved_after(&grid, (&unknown, &w), None);
+        let far = whole.log2(grid.index(398, 2)) * std::f64::consts::LOG10_2;
+        assert!(far < -100.0, "log10 W at the end: {far}");
+        for k in (0..grid.len()).filter(|&k| unknown[k]) {
+            let (a, b) = (on_box.log2(k), whole.log2(k));
+            assert!((a - b).abs() < 1e-5, "cell {k}: log2 W {a} against {b}");
+        }
+    }
+
+    /// In an open room `W` is above the depth everywhere, and a box 32 cells wide in a grid
+    /// 160 wide cuts through it: the first solve is made again on every cell, from the start,
+    /// and gives that solve's field to the bit.
+    #[test]
+    fn a_box_too_small_for_the_field_is_solved_again_on_every_cell() {
+        let grid = Grid::covering([16.0, 16.0], 0.1);
+        let blocked = vec![false; grid.len()];
+        let (unknown, w) = start_of(&grid, &blocked, (80, 80));
+        let boxed = first_box(&grid, &unknown, &[grid.index(80, 80)], 32).expect("a box");
+        let (first, again) = solved_after(&grid, (&unknown, &w), Some(&boxed));
+        assert_eq!(first.solves, 2);
+        let (whole_first, whole) = solved_after(&grid, (&unknown, &w), None);
+        assert!(first.iterations > whole_first.iterations);
+        let bits = |w: &ScaledW| {
+            (0..grid.len())
+                .map(|k| w.value(k).to_bits())
+                .collect::<Vec<_>>()
+        };
+        assert!(bits(&again) == bits(&whole), "the fields differ");
+        // A room under sixteen boxes is solved whole at once.
+        assert!(first_box(&grid, &unknown, &[grid.index(80, 80)], 41).is_none());
     }
 
     /// A long corridor: `W` decays by about e^(−π) per corridor width, to far below what one

@@ -178,6 +178,53 @@ pub fn deep_cells(grid: &Grid, unknown: &[bool], w: &[f64], depth: f64) -> Vec<b
     deep
 }
 
+/// After a first solve on the cells `solved` only, with `W = 0` held on the other `unknown`
+/// cells (a box around the target on a large map: see `harmonic.rs`), marks `pending` the
+/// solved cells that the cut between the two may have changed, by the rule of a nested level
+/// (see [`Levels::resolved`]): those within [`MARGIN`] steps of it, and those below [`GAP`]
+/// times the largest `W` there. Returns whether that left every cell above [`DEPTH_STEP`]
+/// accepted; if not, the cut kept the solve from resolving what it should have (a box too
+/// small for the field's depth), and the first solve must be made on every cell.
+pub fn cut_from_the_rest(
+    grid: &Grid,
+    (unknown, solved): (&[bool], &[bool]),
+    w: &[f64],
+    pending: &mut [bool],
+) -> bool {
+    let mut near = vec![false; grid.len()];
+    // The cut: solved cells next to an unknown one that was not solved.
+    let mut layer: Vec<usize> = (0..grid.len())
+        .filter(|&k| solved[k] && grid.neighbours_of(k).any(|m| unknown[m] && !solved[m]))
+        .collect();
+    let mut cells = layer.clone();
+    for &k in &layer {
+        near[k] = true;
+    }
+    for _ in 0..MARGIN {
+        let mut next = Vec::new();
+        for &k in &layer {
+            for m in grid.neighbours_of(k) {
+                if solved[m] && !near[m] {
+                    near[m] = true;
+                    next.push(m);
+                }
+            }
+        }
+        cells.extend_from_slice(&next);
+        layer = next;
+    }
+    let at_cut = cells.iter().map(|&k| w[k]).fold(0.0, f64::max);
+    for k in 0..grid.len() {
+        if solved[k] && !pending[k] && (near[k] || w[k] < GAP * at_cut) {
+            if w[k] >= DEPTH_STEP {
+                return false;
+            }
+            pending[k] = true;
+        }
+    }
+    true
+}
+
 /// A level's parts are solved in parallel when they hold at least this many cells together
 /// (below it, the threads would cost more than they save; the results are the same either way).
 pub const PARALLEL_CELLS: usize = 20_000;
