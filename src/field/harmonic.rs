@@ -451,8 +451,8 @@ pub struct HarmonicSolution {
 /// Solves for `W` on the `reachable` cells with `W = 1` on the `target` cells (the target
 /// disc), each solve to a relative residual of `tolerance`: the first solve over the whole
 /// grid (on a map of 16 boxes 512 cells wide or more, over one around the target when that
-/// resolves as much), then the nested levels below what it resolves. `warm` is a previous `W` on the same
-/// grid to start the first solve from (after a small change of the world), if any.
+/// resolves as much), then the nested levels below what it resolves. `warm` is a previous `W`
+/// on the same grid to start the first solve from (after a small change of the world), if any.
 pub fn solve_w(
     grid: &Grid,
     reachable: &[bool],
@@ -510,14 +510,16 @@ pub fn solve_w_for(
 pub const FIRST_BOX: usize = 512;
 
 /// The unknown cells of the box `side` ([`FIRST_BOX`]) cells wider than the `target` cells,
-/// when the grid has at least 16 times its cells and unknown cells beyond it. The first solve resolves
-/// `W` to [`DEPTH_STEP`] only: on a map of rooms that is a few rooms around the target (on the
-/// Moving AI rooms map's 2560² grid, 1 153 of its 4.58 M cells; `W` falls below 1e-44 within
-/// 256 cells of the target there), and the nested levels solve the rest again band by band.
-/// So the first solve is made on a box, which costs a sixteenth of the grid at most, and on
-/// the whole grid only when the box turns out too small for the field (see [`first_solve`]).
-/// A room, whose field is shallow everywhere, is smaller than sixteen boxes and is solved
-/// whole at once.
+/// when the grid has at least 16 times its cells and unknown cells beyond it.
+///
+/// The first solve resolves `W` to [`DEPTH_STEP`] only: on a map of rooms, a few rooms around
+/// the target (on the Moving AI rooms map's 2560² grid, 1 153 of its 4.58 M cells; `W` falls
+/// below 1e-44 within 256 cells of the target there), and the nested levels solve the rest
+/// again band by band. So the first solve is made on a box, a sixteenth of the grid at most,
+/// and on the whole grid only when the box turns out too small for the field (see
+/// [`first_solve`]). That costs the box's solve on top (the paper's room at 2049² cells, whose
+/// field is shallow everywhere: 13 iterations on 262 k cells, an eighth more CPU time); a room
+/// smaller than sixteen boxes is solved whole at once.
 fn first_box(grid: &Grid, unknown: &[bool], target: &[usize], side: usize) -> Option<Vec<bool>> {
     if grid.len() / 16 < side * side {
         return None;
