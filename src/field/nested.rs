@@ -238,6 +238,8 @@ struct Part {
     /// on): it goes to multigrid without building the direct solve's system first, a pass
     /// over all its cells (5 ms of the 1024² room's 147 k-cell part).
     wide: bool,
+    /// Its number, in its cells' marks (`Levels::part`).
+    number: u32,
 }
 
 /// One part of a band, solved: its cells' values (in the part's order) at the scale `2^scale`.
@@ -265,13 +267,12 @@ struct Levels<'a> {
     /// Steps from the accepted cells (in the band); beyond it, the tail search's marks (see
     /// [`TailSearch`]).
     dist: Vec<u32>,
-    /// Index of the part of the band a cell is in (in the band).
+    /// The number of the part of the band a cell is in (in the band; see [`PartSearch`]).
     part: Vec<u32>,
-    /// The search for the band's parts' marks: `seen[k] == stamp` (see [`PartSearch`]).
-    seen: Vec<u32>,
     /// A band cell's index in its part (set with `part` by [`PartSearch`]).
     slot: Vec<u32>,
-    stamp: u32,
+    /// Parts numbered so far (see [`PartSearch`]).
+    numbered: u32,
     level: u32,
     /// The extent of the next band's core, in steps.
     core_steps: u32,
@@ -362,9 +363,8 @@ impl<'a> Levels<'a> {
             band: vec![0; n],
             dist: vec![0; n],
             part: vec![0; n],
-            seen: vec![0; n],
             slot: vec![0; n],
-            stamp: 0,
+            numbered: 0,
             level: 0,
             core_steps: CORE_STEPS,
             settled: false,
@@ -447,17 +447,17 @@ impl<'a> Levels<'a> {
         // solved, and their resolved cells found, independently (in parallel when there is
         // enough work) with the same results.
         let this = &*self;
-        let solve = |(index, part): (usize, &Part)| {
-            let solved = this.solve_part(index as u32, part);
+        let solve = |part: &Part| {
+            let solved = this.solve_part(part);
             let resolved = this.resolved(&part.cells, &solved, lowest);
             (solved, resolved)
         };
         let work: usize = parts.iter().map(|p| p.cells.len()).sum();
         let results: Vec<(Solved, (Vec<usize>, bool))> =
             if parts.len() > 1 && work >= PARALLEL_CELLS {
-                parts.par_iter().enumerate().map(solve).collect()
+                parts.par_iter().map(solve).collect()
             } else {
-                parts.iter().enumerate().map(solve).collect()
+                parts.iter().map(solve).collect()
             };
         let mut accepted = Vec::new();
         let mut cut_limited = false;
@@ -552,15 +552,13 @@ impl<'a> Levels<'a> {
     /// The searches for this level's band's parts and for its tail, each with the marks it
     /// reads and writes (apart, so that they can run at once).
     fn searches(&mut self) -> (PartSearch<'_>, TailSearch<'_>) {
-        self.stamp += 1;
         let parts = PartSearch {
             grid: self.grid,
             band: &self.band,
             level: self.level,
-            seen: &mut self.seen,
             slot: &mut self.slot,
             part: &mut self.part,
-            stamp: self.stamp,
+            numbered: &mut self.numbered,
         };
         let tail = TailSearch {
             grid: self.grid,
@@ -572,11 +570,18 @@ impl<'a> Levels<'a> {
         (parts, tail)
     }
 
-    /// Solves part `index` of the band (its cells are in the order of their slots), with the
+    /// Solves a part of the band (its cells are in the order of their slots), with the
     /// accepted cells around it as Dirichlet values and 0 at the cut, at the scale `2^e` of its
     /// largest accepted neighbour: directly when it is narrow, else by multigrid (see
     /// [`Levels::solve_wide`]). Reads only `self`.
-    fn solve_part(&self, index: u32, Part { cells, wide }: &Part) -> Solved {
+    fn solve_part(
+        &self,
+        Part {
+            cells,
+            wide,
+            number,
+        }: &Part,
+    ) -> Solved {
         let scale = cells
             .iter()
             .flat_map(|&k| self.neighbours(k))
@@ -587,7 +592,7 @@ impl<'a> Levels<'a> {
         let narrow = if *wide {
             None
         } else {
-            self.solve_narrow(index, cells, scale)
+            self.solve_narrow(*number, cells, scale)
         };
         match narrow {
             Some(values) => Solved {
@@ -600,10 +605,10 @@ impl<'a> Levels<'a> {
         }
     }
 
-    /// Solves part `index` directly (see `banded.rs`) at the scale `2^scale`; `None` when it
-    /// is too wide for that.
-    fn solve_narrow(&self, index: u32, cells: &[usize], scale: i32) -> Option<Vec<f64>> {
-        let mine = |m: usize| self.in_band(m) && self.part[m] == index;
+    /// Solves the part numbered `number` directly (see `banded.rs`) at the scale `2^scale`;
+    /// `None` when it is too wide for that.
+    fn solve_narrow(&self, number: u32, cells: &[usize], scale: i32) -> Option<Vec<f64>> {
+        let mine = |m: usize| self.in_band(m) && self.part[m] == number;
         let mut neighbours = Vec::with_capacity(cells.len());
         let mut rhs = vec![0.0; cells.len()];
         for (slot, &k) in cells.iter().enumerate() {
@@ -734,40 +739,45 @@ impl<'a> Levels<'a> {
 }
 
 /// The search for the connected parts (4-neighbours) of a band (see [`Levels`] for the marks).
+///
+/// Parts are numbered on from every part any search numbered before, so a cell whose number
+/// is below this search's first has not been reached by it: the numbers are the search's
+/// marks too (one grid-wide array, not two: a deep map's levels write nearly every cell of
+/// each, and fresh memory costs most at its first write).
 struct PartSearch<'a> {
     grid: &'a Grid,
     band: &'a [u32],
     level: u32,
-    seen: &'a mut [u32],
     slot: &'a mut [u32],
     part: &'a mut [u32],
-    /// This search's stamp in `seen`.
-    stamp: u32,
+    /// Parts numbered so far, by every search.
+    numbered: &'a mut u32,
 }
 
 impl PartSearch<'_> {
-    /// The parts of `band` (the cells whose mark is `level`), setting each cell's part and slot.
+    /// The parts of `band` (the cells whose mark is `level`), setting each cell's part number
+    /// and slot.
     fn run(self, band: &[usize]) -> Vec<Part> {
-        let (grid, stamp) = (self.grid, self.stamp);
+        let grid = self.grid;
+        // Numbers from 1: a cell no search reached holds 0.
+        let first = *self.numbered + 1;
         let mut parts = Vec::new();
         for &start in band {
-            if self.seen[start] == stamp {
+            if self.part[start] >= first {
                 continue;
             }
-            self.seen[start] = stamp;
-            let index = parts.len() as u32;
+            let number = first + parts.len() as u32;
             let mut cells = vec![start];
+            (self.part[start], self.slot[start]) = (number, 0);
             let mut head = 0;
             // The cells within `depth` steps of `start` are `cells[..reached]`.
             let (mut depth, mut reached, mut wide) = (0, 1, false);
             while head < cells.len() {
                 let k = cells[head];
-                self.slot[k] = head as u32;
                 head += 1;
-                self.part[k] = index;
                 for m in grid.neighbours_of(k) {
-                    if self.band[m] == self.level && self.seen[m] != stamp {
-                        self.seen[m] = stamp;
+                    if self.band[m] == self.level && self.part[m] < first {
+                        (self.part[m], self.slot[m]) = (number, cells.len() as u32);
                         cells.push(m);
                     }
                 }
@@ -776,8 +786,13 @@ impl PartSearch<'_> {
                     wide |= banded::proves_wider(reached, depth, MAX_BAND);
                 }
             }
-            parts.push(Part { cells, wide });
+            parts.push(Part {
+                cells,
+                wide,
+                number,
+            });
         }
+        *self.numbered += parts.len() as u32;
         parts
     }
 }
@@ -962,8 +977,8 @@ mod tests {
         }
         let parts = levels.searches().0.run(&band);
         assert_eq!(parts.len(), 2);
-        for (index, part) in parts.iter().enumerate() {
-            let direct = levels.solve_narrow(index as u32, &part.cells, 0);
+        for part in &parts {
+            let direct = levels.solve_narrow(part.number, &part.cells, 0);
             if part.cells.len() == 200 * 200 {
                 assert!(part.wide && direct.is_none());
             } else {
