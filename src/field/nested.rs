@@ -196,9 +196,11 @@ pub fn cut_from_the_rest(
     let mut layer: Vec<usize> = (0..grid.len())
         .filter(|&k| solved[k] && grid.neighbours_of(k).any(|m| unknown[m] && !solved[m]))
         .collect();
-    let mut cells = layer.clone();
+    // The largest `W` within MARGIN steps of the cut.
+    let mut at_cut: f64 = 0.0;
     for &k in &layer {
         near[k] = true;
+        at_cut = at_cut.max(w[k]);
     }
     for _ in 0..MARGIN {
         let mut next = Vec::new();
@@ -206,14 +208,13 @@ pub fn cut_from_the_rest(
             for m in grid.neighbours_of(k) {
                 if solved[m] && !near[m] {
                     near[m] = true;
+                    at_cut = at_cut.max(w[m]);
                     next.push(m);
                 }
             }
         }
-        cells.extend_from_slice(&next);
         layer = next;
     }
-    let at_cut = cells.iter().map(|&k| w[k]).fold(0.0, f64::max);
     for k in 0..grid.len() {
         if solved[k] && !pending[k] && (near[k] || w[k] < GAP * at_cut) {
             if w[k] >= DEPTH_STEP {

@@ -95,12 +95,17 @@ impl Layout {
         self.start[r] + c - self.first[r]
     }
 
+    /// The padded columns padded row `r` stores (none where there is no such row).
+    fn columns(&self, r: usize) -> std::ops::Range<usize> {
+        match self.first.get(r) {
+            Some(&first) => first..first + self.start[r + 1] - self.start[r],
+            None => 0..0,
+        }
+    }
+
     /// The index of padded column `c` of padded row `r`, if the row stores it.
     fn stored(&self, c: usize, r: usize) -> Option<usize> {
-        let (first, width) = (*self.first.get(r)?, self.start[r + 1] - self.start[r]);
-        (first..first + width)
-            .contains(&c)
-            .then(|| self.start[r] + c - first)
+        self.columns(r).contains(&c).then(|| self.at(c, r))
     }
 }
 
@@ -195,11 +200,9 @@ impl Level {
     /// The cells of row `j` inside the grid that the layout stores, and the index of the
     /// first.
     pub fn stored(&self, j: usize) -> (usize, std::ops::Range<usize>) {
-        let r = j + 1;
-        let first = self.layout.first[r];
-        let width = self.layout.start[r + 1] - self.layout.start[r];
-        // Padded columns [first, first + width) less the ring's two: cells from first − 1.
-        let cells = first.max(1) - 1..(first + width).min(self.nx + 1).saturating_sub(1);
+        let padded = self.layout.columns(j + 1);
+        // The padded columns less the ring's two: cells from one before the first.
+        let cells = padded.start.max(1) - 1..padded.end.min(self.nx + 1).saturating_sub(1);
         let cells = cells.start..cells.end.max(cells.start);
         let k = if cells.is_empty() {
             0
@@ -252,13 +255,10 @@ impl Level {
     fn row_of(&self, v: &[f32], r: usize, cols: std::ops::Range<usize>, out: &mut Vec<f32>) {
         out.clear();
         out.resize(cols.len(), 0.0);
-        let Some(&first) = self.layout.first.get(r) else {
-            return;
-        };
-        let end = first + self.layout.start[r + 1] - self.layout.start[r];
-        let (lo, hi) = (cols.start.max(first), cols.end.min(end));
+        let stored = self.layout.columns(r);
+        let (lo, hi) = (cols.start.max(stored.start), cols.end.min(stored.end));
         if lo < hi {
-            let k = self.layout.start[r] + lo - first;
+            let k = self.layout.at(lo, r);
             out[lo - cols.start..hi - cols.start].copy_from_slice(&v[k..k + hi - lo]);
         }
     }

@@ -38,13 +38,13 @@
 //! problem stores only its cells and theirs (`rows.rs`): a part's bounding box can be five
 //! times its cells, and memory first touched costs more than the arithmetic on it; a cycle
 //! starts from zero without clearing its vectors (its first pass reads nothing of them), and it
-//! sums `z · r` in its last pass, while each row is still in cache; and each CG iteration makes two passes over its vectors besides
-//! the cycle (`Krylov`): one makes the new search direction and its curvature `p · A p`, the
-//! other updates the solution and the residual. The search direction is kept in f32, scaled
-//! like the cycle's output it is made from, and `A p` is recomputed from it rather than stored:
-//! the solution and the residual, in f64, take the same exact steps, so rounding the direction
-//! only changes which direction CG takes (by 1e-7, as the f32 cycle already does) and never
-//! lets the residual drift from `b − A x`.
+//! sums `z · r` in its last pass, while each row is still in cache; and each CG iteration makes
+//! two passes over its vectors besides the cycle (`Krylov`): one makes the new search
+//! direction and its curvature `p · A p`, the other updates the solution and the residual. The
+//! search direction is kept in f32, scaled like the cycle's output it is made from, and `A p`
+//! is recomputed from it rather than stored: the solution and the residual, in f64, take the
+//! same exact steps, so rounding the direction only changes which direction CG takes (by 1e-7,
+//! as the f32 cycle already does) and never lets the residual drift from `b − A x`.
 //!
 //! A level at least 256 rows tall (the fine levels of a whole map's field) is swept by two
 //! threads: the rows below its middle and those above it at once, each pass stopping short of
@@ -378,10 +378,9 @@ mod tests {
     }
 
     /// A band, straight and then slanted, held at 1 at its lower end and at uneven values along
-    /// its sides, with a
-    /// starting guess: solved on the cells `Rows::around` stores (a nested part's way), it
-    /// gives the solution over its whole grid to the bit, in the same iterations, and stores
-    /// under a quarter of the grid.
+    /// its sides, with a starting guess: solved on the cells `Rows::around` stores (a nested
+    /// part's way), it gives the solution over its whole grid to the bit, in the same
+    /// iterations, and stores under a quarter of the grid.
     #[test]
     fn a_problem_stored_around_its_cells_solves_as_on_its_whole_grid() {
         let grid = Grid::covering([3.2, 2.0], 0.02);
