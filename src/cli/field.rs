@@ -102,7 +102,7 @@ pub fn field(args: &FieldArgs) -> Result<(), Failure> {
         field.iterations,
         field.relative_residual
     );
-    if field.first_cells < counts.reachable {
+    if field.first_on_box {
         say!(
             "first solve: on the {} unknown cells of a box around the target",
             field.first_cells

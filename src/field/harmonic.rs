@@ -57,6 +57,9 @@ pub struct HarmonicField {
     /// The unknown cells of the first solve: every reachable cell, or on a large map those of
     /// a box around the target (both, when the box was too small: see [`solve_w`]).
     pub first_cells: usize,
+    /// Whether the first solve's result is that of a box around the target (a large map's,
+    /// when the box was large enough: see [`solve_w`]).
+    pub first_on_box: bool,
     /// The nested levels below the first solve.
     pub nested: LevelStats,
     /// The worst final relative residual of the solves.
@@ -164,6 +167,7 @@ impl HarmonicField {
             iterations: solution.iterations,
             solves: solution.solves,
             first_cells: solution.first_cells,
+            first_on_box: solution.first_on_box,
             nested: solution.nested,
             relative_residual: solution.relative_residual,
             solve_time: started.elapsed(),
@@ -442,6 +446,8 @@ pub struct HarmonicSolution {
     pub solves: usize,
     /// The unknown cells of the first solve (see [`HarmonicField::first_cells`]).
     pub first_cells: usize,
+    /// Whether the first solve's result is a box's (see [`HarmonicField::first_on_box`]).
+    pub first_on_box: bool,
     /// The worst final relative residual of the solves.
     pub relative_residual: f64,
     /// The nested levels (see `nested.rs`).
@@ -500,6 +506,7 @@ pub fn solve_w_for(
         iterations: first.iterations + nested.iterations,
         solves: first.solves + nested.solves,
         first_cells: first.cells,
+        first_on_box: first.on_box,
         relative_residual: first.relative_residual.max(nested.relative_residual),
         nested,
     }
@@ -539,12 +546,13 @@ fn first_box(grid: &Grid, unknown: &[bool], target: &[usize], side: usize) -> Op
 }
 
 /// How the first solve went: its CG iterations and final residual, how many solves it took
-/// (two when a box was too small) and their unknown cells.
+/// (two when a box was too small), their unknown cells, and whether the box's was kept.
 struct FirstSolve {
     iterations: usize,
     relative_residual: f64,
     solves: usize,
     cells: usize,
+    on_box: bool,
 }
 
 /// The first solve of `w` on the `unknown` cells (from `w` as it is), and the cells it leaves
@@ -564,6 +572,7 @@ fn first_solve(
         relative_residual: 0.0,
         solves: 0,
         cells: 0,
+        on_box: false,
     };
     let count = |cells: &[bool]| cells.iter().filter(|&&u| u).count();
     if let Some(boxed) = boxed {
@@ -577,6 +586,7 @@ fn first_solve(
                 relative_residual: stats.relative_residual,
                 solves: 1,
                 cells: count(boxed),
+                on_box: true,
             };
             return (first, pending);
         }
@@ -589,6 +599,7 @@ fn first_solve(
             relative_residual: 0.0,
             solves: 1,
             cells: count(boxed),
+            on_box: false,
         };
     }
     let stats = multigrid::solve(grid, unknown, w, tolerance, MAX_ITERATIONS);
@@ -597,6 +608,7 @@ fn first_solve(
         relative_residual: stats.relative_residual,
         solves: tried.solves + 1,
         cells: tried.cells + count(unknown),
+        on_box: false,
     };
     (first, deep_cells(grid, unknown, w, DEPTH_STEP))
 }
@@ -707,6 +719,7 @@ mod tests {
         assert!(boxed.iter().filter(|b| **b).count() < 200);
         let (first, on_box) = solved_after(&grid, (&unknown, &w), Some(&boxed));
         assert_eq!(first.solves, 1, "the box was enough");
+        assert!(first.on_box);
         let (_, whole) = solved_after(&grid, (&unknown, &w), None);
         let far = whole.log2(grid.index(398, 2)) * std::f64::consts::LOG10_2;
         assert!(far < -100.0, "log10 W at the end: {far}");
@@ -727,6 +740,7 @@ mod tests {
         let boxed = first_box(&grid, &unknown, &[grid.index(80, 80)], 32).expect("a box");
         let (first, again) = solved_after(&grid, (&unknown, &w), Some(&boxed));
         assert_eq!(first.solves, 2);
+        assert!(!first.on_box);
         let (whole_first, whole) = solved_after(&grid, (&unknown, &w), None);
         assert!(first.iterations > whole_first.iterations);
         let bits = |w: &ScaledW| {
