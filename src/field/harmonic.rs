@@ -20,7 +20,8 @@ use super::grid::Grid;
 use super::mask::CellCounts;
 use super::multigrid;
 use super::nested::{
-    DEPTH_STEP, LevelStats, MAX_ITERATIONS, Stop, cut_from_the_rest, deep_cells, solve_levels,
+    DEPTH_STEP, LevelStats, MAX_BAND, MAX_ITERATIONS, Stop, cut_from_the_rest, deep_cells,
+    solve_levels,
 };
 use super::scaled::{ScaledW, ldexp};
 use super::window::{Reach, Window};
@@ -500,7 +501,7 @@ pub fn solve_w_for(
         .flatten();
     let (first, pending) = first_solve(grid, (&unknown, boxed.as_deref()), &mut w, tolerance);
     let mut w = ScaledW::from_plain(w);
-    let nested = solve_levels(grid, pending, &mut w, tolerance, stop);
+    let nested = solve_levels(grid, pending, &mut w, (tolerance, MAX_BAND), stop);
     HarmonicSolution {
         w,
         iterations: first.iterations + nested.iterations,
@@ -698,7 +699,7 @@ mod tests {
         let mut w = w.to_vec();
         let (first, pending) = first_solve(grid, (unknown, boxed), &mut w, 1e-12);
         let mut w = ScaledW::from_plain(w);
-        solve_levels(grid, pending, &mut w, 1e-12, &Stop::Never);
+        solve_levels(grid, pending, &mut w, (1e-12, MAX_BAND), &Stop::Never);
         (first, w)
     }
 

@@ -108,9 +108,19 @@ pub const NO_DIGIT: f64 = f64::EPSILON;
 /// about a room back, through its one-cell door; in a corridor one cell wide, 87 cells). A
 /// field exported or drawn on its own (`nadf field`) is solved to every cell.
 pub const BELOW_AGENT: f64 = 1e-50;
-/// The widest band a part may have to be solved directly (`banded.rs`) rather than by
-/// multigrid: a few corridors side by side.
-pub const MAX_BAND: usize = 48;
+/// The widest band a part of a field's level may have to be solved directly (`banded.rs`)
+/// rather than by multigrid: a corridor or two. The direct solve costs `n · b²` for a band `b`,
+/// multigrid about 13 iterations of a few tens of nanoseconds per cell, so past a dozen cells
+/// multigrid is the cheaper. Measured on the rooms map's longest field (`nadf field`, 2 cores):
+/// 3.33–3.40 s against 3.90–4.44 s with 48; 13.2 M cells solved in both, 4,894 CG iterations
+/// against 3,192 (the parts solved directly count none). Bands of 8 and 16 measured like 12.
+pub const MAX_BAND: usize = 12;
+/// [`MAX_BAND`] for a window's field: with 12 there, the crowds fell back to whole re-solves
+/// more often (64 robots on the 1.8 m circle: 146 against 94; over four seeds of 16 and of 32
+/// robots, 876 and 1,643 against 797 and 1,514), probably because a window is solved to a
+/// looser tolerance, which multigrid meets on a narrow part less exactly than the direct
+/// solve, cell by cell.
+pub const WINDOW_MAX_BAND: usize = 48;
 
 /// What the nested levels did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -259,6 +269,8 @@ struct Levels<'a> {
     grid: &'a Grid,
     w: &'a mut ScaledW,
     tolerance: f64,
+    /// The widest part solved directly ([`MAX_BAND`] or [`WINDOW_MAX_BAND`]).
+    max_band: usize,
     /// Reachable cells not accepted yet.
     pending: Vec<bool>,
     /// Accepted cells with a pending neighbour.
@@ -302,12 +314,13 @@ pub enum Stop {
 
 /// Runs the nested levels on `w` (the first solve's values, exponent 0) until every cell is
 /// accepted, or until `stop` allows; `pending` are the cells the first solve did not resolve.
+/// Each part is solved to `tolerance`, directly when its band is at most `max_band`.
 /// The cells still pending then are left at 0 (counted in [`LevelStats::left`]).
 pub fn solve_levels(
     grid: &Grid,
     pending: Vec<bool>,
     w: &mut ScaledW,
-    tolerance: f64,
+    (tolerance, max_band): (f64, usize),
     stop: &Stop,
 ) -> LevelStats {
     // Nothing deep (a window, most often): nothing to set up.
@@ -315,7 +328,7 @@ pub fn solve_levels(
         return LevelStats::default();
     }
     let n = grid.len();
-    let mut levels = Levels::new(grid, pending, w, tolerance);
+    let mut levels = Levels::new(grid, pending, w, (tolerance, max_band));
     // The first frontier: accepted cells (the target among them) next to pending ones.
     for k in 0..n {
         if levels.accepted(k) && levels.neighbours(k).any(|m| levels.pending[m]) {
@@ -354,12 +367,18 @@ pub fn solve_levels(
 
 impl<'a> Levels<'a> {
     /// No level run yet, no frontier, `pending` as given.
-    fn new(grid: &'a Grid, pending: Vec<bool>, w: &'a mut ScaledW, tolerance: f64) -> Self {
+    fn new(
+        grid: &'a Grid,
+        pending: Vec<bool>,
+        w: &'a mut ScaledW,
+        (tolerance, max_band): (f64, usize),
+    ) -> Self {
         let n = grid.len();
         Self {
             grid,
             w,
             tolerance,
+            max_band,
             frontier: Vec::new(),
             band: vec![0; n],
             dist: vec![0; n],
@@ -557,6 +576,7 @@ impl<'a> Levels<'a> {
             grid: self.grid,
             band: &self.band,
             level: self.level,
+            max_band: self.max_band,
             slot: &mut self.slot,
             part: &mut self.part,
             numbered: &mut self.numbered,
@@ -623,7 +643,7 @@ impl<'a> Levels<'a> {
             }
             neighbours.push(inside);
         }
-        banded::solve(&neighbours, &rhs, MAX_BAND)
+        banded::solve(&neighbours, &rhs, self.max_band)
     }
 
     /// Solves a wide part by multigrid at the scale `2^scale`, on its cells and the cells next
@@ -749,6 +769,8 @@ struct PartSearch<'a> {
     grid: &'a Grid,
     band: &'a [u32],
     level: u32,
+    /// The widest part solved directly (see [`MAX_BAND`]).
+    max_band: usize,
     slot: &'a mut [u32],
     part: &'a mut [u32],
     /// Parts numbered so far, by every search.
@@ -784,7 +806,7 @@ impl PartSearch<'_> {
                 }
                 if head == reached {
                     (depth, reached) = (depth + 1, cells.len());
-                    wide |= banded::proves_wider(reached, depth, MAX_BAND);
+                    wide |= banded::proves_wider(reached, depth, self.max_band);
                 }
             }
             parts.push(Part {
@@ -971,7 +993,7 @@ mod tests {
             .map(|(i, j)| grid.index(i, j))
             .collect();
         let mut w = ScaledW::from_plain(vec![0.0; grid.len()]);
-        let mut levels = Levels::new(&grid, vec![true; grid.len()], &mut w, 1e-12);
+        let mut levels = Levels::new(&grid, vec![true; grid.len()], &mut w, (1e-12, MAX_BAND));
         levels.level = 1;
         for &k in &band {
             levels.band[k] = 1;
@@ -986,6 +1008,41 @@ mod tests {
                 assert_eq!(part.cells.len(), 220 * 3);
                 assert!(!part.wide && direct.is_some());
             }
+        }
+    }
+
+    /// A straight corridor 20 cells wide and 600 long, from a target at one end: `W` falls by
+    /// about `e^(−π/21)` per cell, to 1e-38 at the other. With a band of 48 its parts are
+    /// solved directly (no CG iteration); with [`MAX_BAND`] (12) by multigrid, and the field
+    /// is the same to six digits on every cell.
+    #[test]
+    fn a_part_wider_than_the_band_is_solved_by_multigrid_to_the_same_field() {
+        let grid = Grid::covering([604.0, 24.0], 1.0);
+        let blocked: Vec<bool> = (0..grid.len())
+            .map(|k| !(2..602).contains(&(k % grid.nx)) || !(2..22).contains(&(k / grid.nx)))
+            .collect();
+        let reachable = reachable_from(&grid, &blocked, (2, 12));
+        let target = grid.index(2, 12);
+        let with = |max_band: usize| {
+            let mut unknown = reachable.clone();
+            unknown[target] = false;
+            let mut w = vec![0.0; grid.len()];
+            w[target] = 1.0;
+            multigrid::solve(&grid, &unknown, &mut w, 1e-12, MAX_ITERATIONS);
+            let pending = deep_cells(&grid, &unknown, &w, DEPTH_STEP);
+            let mut w = ScaledW::from_plain(w);
+            let stats = solve_levels(&grid, pending, &mut w, (1e-12, max_band), &Stop::Never);
+            (w, stats)
+        };
+        let ((direct, by_band), (by_multigrid, by_cg)) = (with(48), with(MAX_BAND));
+        assert!(by_band.levels > 4, "{by_band:?}");
+        assert_eq!(by_band.iterations, 0, "{by_band:?}");
+        assert!(by_cg.iterations > 0, "{by_cg:?}");
+        let end = grid.index(601, 12);
+        assert!(direct.log10(end) < -35.0, "{}", direct.log10(end));
+        for k in (0..grid.len()).filter(|&k| reachable[k]) {
+            let (a, b) = (direct.log2(k), by_multigrid.log2(k));
+            assert!((a - b).abs() < 1e-5, "cell {k}: log2 W {a} against {b}");
         }
     }
 

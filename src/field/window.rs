@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 use super::grid::Grid;
 use super::mask::{Disc, disc_cells, obstacle_discs};
 use super::multigrid::{self, Cycle};
-use super::nested::{DEPTH_STEP, MAX_ITERATIONS, Stop, deep_cells, solve_levels};
+use super::nested::{DEPTH_STEP, MAX_ITERATIONS, Stop, WINDOW_MAX_BAND, deep_cells, solve_levels};
 use super::sample::NEAR;
 use super::scaled::{ScaledW, exponent_of, ldexp};
 use super::{FieldError, Sampler};
@@ -626,7 +626,13 @@ fn solve_problem(
             scaled.exponent[k] = 0;
         }
     }
-    let nested = solve_levels(&local, pending, &mut scaled, tolerance, stop);
+    let nested = solve_levels(
+        &local,
+        pending,
+        &mut scaled,
+        (tolerance, WINDOW_MAX_BAND),
+        stop,
+    );
     Ok((
         Sampler::new(local, scaled, connected),
         stats.iterations + nested.iterations,
