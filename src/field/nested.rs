@@ -838,23 +838,24 @@ impl TailSearch<'_> {
     fn run(self, margin: Vec<usize>, budget: usize) -> Option<Vec<usize>> {
         // Never a step count (each below the number of cells), and this level's own.
         let mark = u32::MAX - self.level;
-        let mut tail = Vec::new();
+        // One queue: the margin's layer, then the tail as it is found (most levels' tail is
+        // larger than the budget, and is searched only until it is).
+        let beyond = margin.len();
+        let mut queue = margin;
         let mut head = 0;
-        let mut frontier = margin;
-        while let Some(&k) = frontier.get(head) {
+        while let Some(&k) = queue.get(head) {
             head += 1;
             for m in self.grid.neighbours_of(k) {
                 if self.pending[m] && self.band[m] != self.level && self.visited[m] != mark {
                     self.visited[m] = mark;
-                    tail.push(m);
-                    frontier.push(m);
+                    queue.push(m);
                 }
             }
-            if tail.len() > budget {
+            if queue.len() - beyond > budget {
                 return None;
             }
         }
-        Some(tail)
+        Some(queue.split_off(beyond))
     }
 }
 
