@@ -532,25 +532,31 @@ impl<'a> Levels<'a> {
                 }
             }
         }
-        // The core: within CORE_STEPS, or through reliable estimates.
+        // The core: within CORE_STEPS, or through reliable estimates; and its cells with a
+        // pending neighbour it leaves out, where the margin starts (in the core's order, so the
+        // margin's layers are those a pass over every core cell would find, in that order).
+        let mut edge = Vec::new();
         let mut head = 0;
         while head < band.len() {
             let k = band[head];
             head += 1;
             let d = self.dist[k] + 1;
             for m in self.neighbours(k) {
-                if self.pending[m]
-                    && self.band[m] != level
-                    && (d <= self.core_steps || self.w.mantissa[m] >= BAND)
-                {
+                if !self.pending[m] || self.band[m] == level {
+                    continue;
+                }
+                if d <= self.core_steps || self.w.mantissa[m] >= BAND {
                     self.band[m] = level;
                     self.dist[m] = d;
                     band.push(m);
+                } else if edge.last() != Some(&k) {
+                    edge.push(k);
                 }
             }
         }
-        // The margin.
-        let mut layer: Vec<usize> = band.clone();
+        // The margin. (A cell the core leaves out at one step it leaves out at every later one,
+        // which is no shorter, so the core's edge is where its pending neighbours are.)
+        let mut layer = edge;
         for _ in 0..MARGIN {
             let mut next = Vec::new();
             for &k in &layer {
