@@ -273,6 +273,8 @@ struct Levels<'a> {
     max_band: usize,
     /// Reachable cells not accepted yet.
     pending: Vec<bool>,
+    /// How many cells are pending.
+    pending_count: usize,
     /// Accepted cells with a pending neighbour.
     frontier: Vec<usize>,
     /// `band[k] == level` when cell `k` is in this level's band.
@@ -389,6 +391,7 @@ impl<'a> Levels<'a> {
             core_steps: CORE_STEPS,
             settled: false,
             stats: LevelStats::default(),
+            pending_count: pending.iter().filter(|&&p| p).count(),
             pending,
         }
     }
@@ -430,6 +433,7 @@ impl<'a> Levels<'a> {
         for k in 0..self.pending.len() {
             if self.pending[k] {
                 self.pending[k] = false;
+                self.pending_count -= 1;
                 self.w.mantissa[k] = 0.0;
                 self.w.exponent[k] = deepest;
                 self.stats.left += 1;
@@ -448,14 +452,20 @@ impl<'a> Levels<'a> {
         // a few decades per level, so a cut never lies where a larger `W` still flows in.
         let lowest = top + LEVEL_RANGE.log2();
         let (mut band, margin) = self.band_cells(lowest);
-        // The band's parts, and meanwhile whether it takes the tail: most levels' tail does not
-        // fit, and the parts found without it stand.
-        let (parts_search, tail_search) = self.searches();
-        let (mut parts, tail) = join_if(
-            band.len() >= PARALLEL_CELLS,
-            || parts_search.run(&band),
-            || tail_search.run(margin, band.len()),
-        );
+        // The band's parts, and meanwhile its tail, when every pending cell left beyond it fits
+        // in as many cells again: most levels' rest does not, and the parts found without it
+        // stand.
+        let rest = self.pending_count - band.len();
+        let (mut parts, tail) = if rest <= band.len() {
+            let (parts_search, tail_search) = self.searches();
+            join_if(
+                band.len() >= PARALLEL_CELLS,
+                || parts_search.run(&band),
+                || tail_search.run(margin, band.len()),
+            )
+        } else {
+            (self.searches().0.run(&band), None)
+        };
         if let Some(tail) = tail {
             for &m in &tail {
                 self.band[m] = self.level;
@@ -507,6 +517,7 @@ impl<'a> Levels<'a> {
         for &k in &accepted {
             self.pending[k] = false;
         }
+        self.pending_count -= accepted.len();
         // The frontier: the old one and the new cells, where they still touch pending cells.
         let mut frontier = std::mem::take(&mut self.frontier);
         frontier.extend_from_slice(&accepted);
@@ -827,10 +838,11 @@ impl PartSearch<'_> {
 }
 
 /// The search for a band's tail: when every pending cell left beyond the margin fits in as
-/// many cells again as the band has, the band takes them all and has no cut (a room's deep
-/// corner); a maze's rest does not fit, and is left for the next levels. It marks the cells it
-/// visits in `visited` (the steps `Levels::dist`, which no pass reads outside the band), not in
-/// the band's marks, so the band's parts can be found meanwhile.
+/// many cells again as the band has, the band takes those its margin leads to and has no cut
+/// there (a room's deep corner); a maze's rest does not fit, and is left for the next levels
+/// without a search (`Levels` counts the pending cells). It marks the cells it visits in
+/// `visited` (the steps `Levels::dist`, which no pass reads outside the band), not in the
+/// band's marks, so the band's parts can be found meanwhile.
 struct TailSearch<'a> {
     grid: &'a Grid,
     pending: &'a [bool],
