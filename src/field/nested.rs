@@ -34,6 +34,8 @@
 //! accepts changes them by little (in a corridor of width `w`, by about `e^(−2π x / w)` at a
 //! distance `x`).
 
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+
 use rayon::prelude::*;
 
 use super::banded;
@@ -253,6 +255,10 @@ struct Part {
     number: u32,
 }
 
+/// A part solved, with its resolved cells and whether the cut kept resolved cells out (see
+/// [`Levels::resolved`]).
+type Outcome = (Solved, (Vec<usize>, bool));
+
 /// One part of a band, solved: its cells' values (in the part's order) at the scale `2^scale`.
 struct Solved {
     values: Vec<f64>,
@@ -283,9 +289,15 @@ struct Levels<'a> {
     /// [`TailSearch`]).
     dist: Vec<u32>,
     /// The number of the part of the band a cell is in (in the band; see [`PartSearch`]).
-    part: Vec<u32>,
+    /// Atomic (relaxed loads and stores, plain ones on x86) so that a part's solve can read its
+    /// cells' marks while the search goes on numbering the next parts' (see
+    /// [`Levels::run_level`]).
+    part: Vec<AtomicU32>,
     /// A band cell's index in its part (set with `part` by [`PartSearch`]).
-    slot: Vec<u32>,
+    slot: Vec<AtomicU32>,
+    /// Levels whose parts were solved as the search found them (see
+    /// [`Levels::search_and_solve`]); `None` when no level may do that.
+    pipelined: Option<usize>,
     /// Parts numbered so far (see [`PartSearch`]).
     numbered: u32,
     level: u32,
@@ -325,12 +337,26 @@ pub fn solve_levels(
     (tolerance, max_band): (f64, usize),
     stop: &Stop,
 ) -> LevelStats {
+    run_levels(grid, pending, w, (tolerance, max_band), stop, true).0
+}
+
+/// [`solve_levels`], solving a level's parts as its search finds them when `pipelined` allows
+/// (see [`Levels::search_and_solve`]), else after it; and how many levels did.
+fn run_levels(
+    grid: &Grid,
+    pending: Vec<bool>,
+    w: &mut ScaledW,
+    (tolerance, max_band): (f64, usize),
+    stop: &Stop,
+    pipelined: bool,
+) -> (LevelStats, usize) {
     // Nothing deep (a window, most often): nothing to set up.
     if !pending.contains(&true) {
-        return LevelStats::default();
+        return (LevelStats::default(), 0);
     }
     let n = grid.len();
     let mut levels = Levels::new(grid, pending, w, (tolerance, max_band));
+    levels.pipelined = pipelined.then_some(0);
     // The first frontier: accepted cells (the target among them) next to pending ones.
     for k in 0..n {
         if levels.accepted(k) && levels.neighbours(k).any(|m| levels.pending[m]) {
@@ -364,7 +390,7 @@ pub fn solve_levels(
         let accepted = levels.run_level(top);
         in_box_pending -= accepted.iter().filter(|&&k| in_box(k)).count();
     }
-    levels.stats
+    (levels.stats, levels.pipelined.unwrap_or(0))
 }
 
 impl<'a> Levels<'a> {
@@ -384,13 +410,14 @@ impl<'a> Levels<'a> {
             frontier: Vec::new(),
             band: vec![0; n],
             dist: vec![0; n],
-            part: vec![0; n],
-            slot: vec![0; n],
+            part: (0..n).map(|_| AtomicU32::new(0)).collect(),
+            slot: (0..n).map(|_| AtomicU32::new(0)).collect(),
             numbered: 0,
             level: 0,
             core_steps: CORE_STEPS,
             settled: false,
             stats: LevelStats::default(),
+            pipelined: None,
             pending_count: pending.iter().filter(|&&p| p).count(),
             pending,
         }
@@ -456,39 +483,36 @@ impl<'a> Levels<'a> {
         // in as many cells again: most levels' rest does not, and the parts found without it
         // stand.
         let rest = self.pending_count - band.len();
-        let (mut parts, tail) = if rest <= band.len() {
+        let pipelined = self.pipelined.is_some() && band.len() >= PARALLEL_CELLS;
+        let (parts, results) = if rest <= band.len() || !pipelined {
             let (parts_search, tail_search) = self.searches();
-            join_if(
-                band.len() >= PARALLEL_CELLS,
-                || parts_search.run(&band),
-                || tail_search.run(margin, band.len()),
-            )
-        } else {
-            (self.searches().0.run(&band), None)
-        };
-        if let Some(tail) = tail {
-            for &m in &tail {
-                self.band[m] = self.level;
-            }
-            band.extend_from_slice(&tail);
-            parts = self.searches().0.run(&band);
-        }
-        // The parts are disjoint and each reads only the accepted cells around it, so they are
-        // solved, and their resolved cells found, independently (in parallel when there is
-        // enough work) with the same results.
-        let this = &*self;
-        let solve = |part: &Part| {
-            let solved = this.solve_part(part);
-            let resolved = this.resolved(&part.cells, &solved, lowest);
-            (solved, resolved)
-        };
-        let work: usize = parts.iter().map(|p| p.cells.len()).sum();
-        let results: Vec<(Solved, (Vec<usize>, bool))> =
-            if parts.len() > 1 && work >= PARALLEL_CELLS {
-                parts.par_iter().map(solve).collect()
+            let (mut parts, tail) = if rest <= band.len() {
+                join_if(
+                    band.len() >= PARALLEL_CELLS,
+                    || parts_search.all(&band),
+                    || tail_search.run(margin, band.len()),
+                )
             } else {
-                parts.iter().map(solve).collect()
+                (parts_search.all(&band), None)
             };
+            if let Some(tail) = tail {
+                for &m in &tail {
+                    self.band[m] = self.level;
+                }
+                band.extend_from_slice(&tail);
+                // Numbered on from the parts found without the tail, which marked their cells.
+                self.numbered += parts.len() as u32;
+                parts = self.searches().0.all(&band);
+            }
+            self.numbered += parts.len() as u32;
+            let results = self.solve_parts(&parts, lowest);
+            (parts, results)
+        } else {
+            let found = self.search_and_solve(&band, lowest);
+            self.numbered += found.len() as u32;
+            self.pipelined = self.pipelined.map(|n| n + 1);
+            found.into_iter().unzip()
+        };
         let mut accepted = Vec::new();
         let mut cut_limited = false;
         for (Part { cells, .. }, (solved, (resolved, limited))) in parts.iter().zip(results) {
@@ -524,6 +548,55 @@ impl<'a> Levels<'a> {
         frontier.retain(|&k| self.neighbours(k).any(|m| self.pending[m]));
         self.frontier = frontier;
         accepted
+    }
+
+    /// Solves `parts` and finds their resolved cells (see [`Levels::solve_and_resolve`]): in
+    /// parallel when there is enough work.
+    fn solve_parts(&self, parts: &[Part], lowest: f64) -> Vec<Outcome> {
+        let solve = |part: &Part| self.solve_and_resolve(part, lowest);
+        let work: usize = parts.iter().map(|p| p.cells.len()).sum();
+        if parts.len() > 1 && work >= PARALLEL_CELLS {
+            parts.par_iter().map(solve).collect()
+        } else {
+            parts.iter().map(solve).collect()
+        }
+    }
+
+    /// The band's parts, each solved (see [`Levels::solve_and_resolve`]) as soon as the search
+    /// has found it, while the search goes on: the search is one thread's work, and the other
+    /// would otherwise wait for it. In the order the search found them, so the results are
+    /// those of searching first and solving after.
+    fn search_and_solve(&self, band: &[usize], lowest: f64) -> Vec<(Part, Outcome)> {
+        let search = self.part_search();
+        let (sender, found) = std::sync::mpsc::channel();
+        rayon::scope(|s| {
+            let mut index = 0;
+            search.run(band, |part| {
+                let sender = sender.clone();
+                s.spawn(move |_| {
+                    let result = self.solve_and_resolve(&part, lowest);
+                    // The receiver outlives the scope.
+                    let _ = sender.send((index, part, result));
+                });
+                index += 1;
+            });
+        });
+        drop(sender);
+        let mut found: Vec<_> = found.into_iter().collect();
+        found.sort_unstable_by_key(|(index, ..)| *index);
+        found
+            .into_iter()
+            .map(|(_, part, result)| (part, result))
+            .collect()
+    }
+
+    /// A part solved, and its resolved cells. The parts are disjoint and each reads only the
+    /// accepted cells around it and its own cells' marks, so they are solved independently,
+    /// with the same results in any order and on any thread.
+    fn solve_and_resolve(&self, part: &Part, lowest: f64) -> Outcome {
+        let solved = self.solve_part(part);
+        let resolved = self.resolved(&part.cells, &solved, lowest);
+        (solved, resolved)
     }
 
     /// This level's band: its core (breadth-first from the frontier) and its margin; and the
@@ -594,9 +667,9 @@ impl<'a> Levels<'a> {
             band: &self.band,
             level: self.level,
             max_band: self.max_band,
-            slot: &mut self.slot,
-            part: &mut self.part,
-            numbered: &mut self.numbered,
+            slot: &self.slot,
+            part: &self.part,
+            first: self.numbered + 1,
         };
         let tail = TailSearch {
             grid: self.grid,
@@ -606,6 +679,19 @@ impl<'a> Levels<'a> {
             visited: &mut self.dist,
         };
         (parts, tail)
+    }
+
+    /// The search for this level's band's parts alone.
+    fn part_search(&self) -> PartSearch<'_> {
+        PartSearch {
+            grid: self.grid,
+            band: &self.band,
+            level: self.level,
+            max_band: self.max_band,
+            slot: &self.slot,
+            part: &self.part,
+            first: self.numbered + 1,
+        }
     }
 
     /// Solves a part of the band (its cells are in the order of their slots), with the
@@ -646,14 +732,14 @@ impl<'a> Levels<'a> {
     /// Solves the part numbered `number` directly (see `banded.rs`) at the scale `2^scale`;
     /// `None` when it is too wide for that.
     fn solve_narrow(&self, number: u32, cells: &[usize], scale: i32) -> Option<Vec<f64>> {
-        let mine = |m: usize| self.in_band(m) && self.part[m] == number;
+        let mine = |m: usize| self.in_band(m) && self.part[m].load(Relaxed) == number;
         let mut neighbours = Vec::with_capacity(cells.len());
         let mut rhs = vec![0.0; cells.len()];
         for (slot, &k) in cells.iter().enumerate() {
             let mut inside = [u32::MAX; 4];
             for (n, m) in self.neighbours(k).enumerate() {
                 if mine(m) {
-                    inside[n] = self.slot[m];
+                    inside[n] = self.slot[m].load(Relaxed);
                 } else if self.accepted(m) {
                     rhs[slot] += self.w.at_scale(m, scale);
                 }
@@ -738,7 +824,7 @@ impl<'a> Levels<'a> {
             let mut next = Vec::new();
             for &s in &layer {
                 for m in self.neighbours(cells[s]) {
-                    let t = self.slot[m] as usize;
+                    let t = self.slot[m].load(Relaxed) as usize;
                     if self.in_band(m) && !near_cut[t] {
                         near_cut[t] = true;
                         next.push(t);
@@ -788,27 +874,29 @@ struct PartSearch<'a> {
     level: u32,
     /// The widest part solved directly (see [`MAX_BAND`]).
     max_band: usize,
-    slot: &'a mut [u32],
-    part: &'a mut [u32],
-    /// Parts numbered so far, by every search.
-    numbered: &'a mut u32,
+    slot: &'a [AtomicU32],
+    part: &'a [AtomicU32],
+    /// The number of this search's first part: one more than every search numbered before.
+    first: u32,
 }
 
 impl PartSearch<'_> {
     /// The parts of `band` (the cells whose mark is `level`), setting each cell's part number
-    /// and slot.
-    fn run(self, band: &[usize]) -> Vec<Part> {
+    /// and slot, handed to `found` one by one as each is complete.
+    fn run(&self, band: &[usize], mut found: impl FnMut(Part)) {
         let grid = self.grid;
         // Numbers from 1: a cell no search reached holds 0.
-        let first = *self.numbered + 1;
-        let mut parts = Vec::new();
+        let (first, mut number) = (self.first, self.first);
+        let mark = |k: usize, number: u32, slot: usize| {
+            self.part[k].store(number, Relaxed);
+            self.slot[k].store(slot as u32, Relaxed);
+        };
         for &start in band {
-            if self.part[start] >= first {
+            if self.part[start].load(Relaxed) >= first {
                 continue;
             }
-            let number = first + parts.len() as u32;
             let mut cells = vec![start];
-            (self.part[start], self.slot[start]) = (number, 0);
+            mark(start, number, 0);
             let mut head = 0;
             // The cells within `depth` steps of `start` are `cells[..reached]`.
             let (mut depth, mut reached, mut wide) = (0, 1, false);
@@ -816,8 +904,8 @@ impl PartSearch<'_> {
                 let k = cells[head];
                 head += 1;
                 for m in grid.neighbours_of(k) {
-                    if self.band[m] == self.level && self.part[m] < first {
-                        (self.part[m], self.slot[m]) = (number, cells.len() as u32);
+                    if self.band[m] == self.level && self.part[m].load(Relaxed) < first {
+                        mark(m, number, cells.len());
                         cells.push(m);
                     }
                 }
@@ -826,13 +914,19 @@ impl PartSearch<'_> {
                     wide |= banded::proves_wider(reached, depth, self.max_band);
                 }
             }
-            parts.push(Part {
+            found(Part {
                 cells,
                 wide,
                 number,
             });
+            number += 1;
         }
-        *self.numbered += parts.len() as u32;
+    }
+
+    /// [`PartSearch::run`]'s parts, in the order it finds them.
+    fn all(&self, band: &[usize]) -> Vec<Part> {
+        let mut parts = Vec::new();
+        self.run(band, |part| parts.push(part));
         parts
     }
 }
@@ -1017,7 +1111,7 @@ mod tests {
         for &k in &band {
             levels.band[k] = 1;
         }
-        let parts = levels.searches().0.run(&band);
+        let parts = levels.searches().0.all(&band);
         assert_eq!(parts.len(), 2);
         for part in &parts {
             let direct = levels.solve_narrow(part.number, &part.cells, 0);
@@ -1063,6 +1157,45 @@ mod tests {
             let (a, b) = (direct.log2(k), by_multigrid.log2(k));
             assert!((a - b).abs() < 1e-5, "cell {k}: log2 W {a} against {b}");
         }
+    }
+
+    /// A room of 480 × 480 cells cut by four walls with a door of two cells each, at
+    /// alternate ends: bands of tens of thousands of cells. Solving each level's parts as the
+    /// search finds them gives the field of searching first and solving after, to the bit.
+    #[test]
+    fn parts_solved_as_they_are_found_give_the_field_of_parts_solved_after() {
+        let grid = Grid::covering([480.0, 480.0], 1.0);
+        let blocked: Vec<bool> = (0..grid.len())
+            .map(|k| {
+                let (i, j) = (k % grid.nx, k / grid.nx);
+                let wall = i % 96 == 95;
+                let door = if (i / 96) % 2 == 0 { j < 2 } else { j >= 478 };
+                wall && !door
+            })
+            .collect();
+        let reachable = reachable_from(&grid, &blocked, (1, 240));
+        let target = grid.index(1, 240);
+        let with = |pipelined: bool| {
+            let mut unknown = reachable.clone();
+            unknown[target] = false;
+            let mut w = vec![0.0; grid.len()];
+            w[target] = 1.0;
+            multigrid::solve(&grid, &unknown, &mut w, 1e-12, MAX_ITERATIONS);
+            let pending = deep_cells(&grid, &unknown, &w, DEPTH_STEP);
+            let mut w = ScaledW::from_plain(w);
+            let params = (1e-12, MAX_BAND);
+            let (stats, levels) =
+                run_levels(&grid, pending, &mut w, params, &Stop::Never, pipelined);
+            (w, stats, levels)
+        };
+        let ((after, stats, none), (found, same, some)) = (with(false), with(true));
+        assert_eq!(none, 0);
+        assert!(some > 3, "{some} levels of {stats:?}");
+        assert_eq!(stats, same);
+        let bits = |w: &ScaledW| (w.mantissa.iter().map(|m| m.to_bits())).collect::<Vec<_>>();
+        assert!(bits(&after) == bits(&found), "the fields differ");
+        assert_eq!(after.exponent, found.exponent);
+        assert!(after.log10(grid.index(478, 240)) < -20.0);
     }
 
     /// The field of the serpentine from the target `(1, 1)`, its nested levels stopping as
