@@ -154,9 +154,22 @@ impl Grid {
         &self,
         cells: impl IntoIterator<Item = usize>,
     ) -> Option<(std::ops::Range<usize>, std::ops::Range<usize>)> {
+        let nx = self.nx;
+        self.box_of(cells.into_iter().map(|k| (k % nx, k / nx)))
+    }
+
+    /// [`Grid::box_around`] the cells `(i, j)`.
+    ///
+    /// ```
+    /// let grid = nadf::field::Grid::covering([1.0, 1.0], 0.1);
+    /// assert_eq!(grid.box_of([(0, 4), (3, 5)]), Some((0..5, 3..7)));
+    /// ```
+    pub fn box_of(
+        &self,
+        cells: impl IntoIterator<Item = (usize, usize)>,
+    ) -> Option<(std::ops::Range<usize>, std::ops::Range<usize>)> {
         let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
-        for k in cells {
-            let (i, j) = (k % self.nx, k / self.nx);
+        for (i, j) in cells {
             lo = [lo[0].min(i), lo[1].min(j)];
             hi = [hi[0].max(i), hi[1].max(j)];
         }

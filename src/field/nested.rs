@@ -706,11 +706,14 @@ impl<'a> Levels<'a> {
             number,
         }: &Part,
     ) -> Solved {
-        let scale = cells
-            .iter()
+        // The accepted cells around the part (some more than once), and the scale of the
+        // largest.
+        let around: Vec<usize> = (cells.iter())
             .flat_map(|&k| self.neighbours(k))
             .filter(|&m| self.accepted(m))
-            .map(|m| self.w.exponent[m] + exponent_of(self.w.mantissa[m]))
+            .collect();
+        let scale = (around.iter())
+            .map(|&m| self.w.exponent[m] + exponent_of(self.w.mantissa[m]))
             .max()
             .unwrap_or(0);
         let narrow = if *wide {
@@ -725,7 +728,7 @@ impl<'a> Levels<'a> {
                 iterations: 0,
                 relative_residual: 0.0,
             },
-            None => self.solve_wide(cells, scale),
+            None => self.solve_wide(cells, &around, scale),
         }
     }
 
@@ -749,23 +752,30 @@ impl<'a> Levels<'a> {
         banded::solve(&neighbours, &rhs, self.max_band)
     }
 
-    /// Solves a wide part by multigrid at the scale `2^scale`, on its cells and the cells next
-    /// to them only (see [`multigrid::Rows`]): the bounding box of a part that winds through
-    /// a map is mostly empty.
-    fn solve_wide(&self, cells: &[usize], scale: i32) -> Solved {
+    /// Solves a wide part by multigrid at the scale `2^scale`, with the accepted cells `around`
+    /// it as Dirichlet values, on its cells and the cells next to them only (see
+    /// [`multigrid::Rows`]): the bounding box of a part that winds through a map is mostly
+    /// empty.
+    fn solve_wide(&self, cells: &[usize], around: &[usize], scale: i32) -> Solved {
         let g = self.grid;
-        let (ir, jr) = (g.box_around(cells.iter().copied())).expect("a part has cells");
+        let column_row = |k: usize| (k % g.nx, k / g.nx);
+        let at: Vec<(usize, usize)> = cells.iter().map(|&k| column_row(k)).collect();
+        let (ir, jr) = g.box_of(at.iter().copied()).expect("a part has cells");
         let (i0, j0) = (ir.start, jr.start);
-        let in_box = |k: usize| (k % g.nx - i0, k / g.nx - j0);
-        let rows = multigrid::Rows::around(ir.len(), jr.len(), cells.iter().map(|&k| in_box(k)));
-        let local = |k: usize| {
-            let (i, j) = in_box(k);
-            rows.index(i, j)
+        let rows = multigrid::Rows::around(
+            ir.len(),
+            jr.len(),
+            at.iter().map(|&(i, j)| (i - i0, j - j0)),
+        );
+        let stored = |(i, j): (usize, usize)| {
+            rows.index(i - i0, j - j0)
                 .expect("a part's cells and their neighbours are stored")
         };
+        // Each cell's index in `rows`.
+        let local: Vec<usize> = at.into_iter().map(stored).collect();
         let mut unknown = vec![false; rows.len()];
-        for &k in cells {
-            unknown[local(k)] = true;
+        for &l in &local {
+            unknown[l] = true;
         }
         // The accepted cells around the part at its scale; 0 everywhere else (blocked cells,
         // the pending cells beyond the cut, and stored cells that do not touch the part);
@@ -776,16 +786,13 @@ impl<'a> Levels<'a> {
         // solve that made it starts at 0 instead (see there).
         let mut values = vec![0.0; rows.len()];
         let mut largest: f64 = 0.0;
-        for &k in cells {
-            for m in self.neighbours(k) {
-                if self.accepted(m) {
-                    values[local(m)] = self.w.at_scale(m, scale);
-                    largest = largest.max(values[local(m)]);
-                }
-            }
+        for &m in around {
+            let value = self.w.at_scale(m, scale);
+            values[stored(column_row(m))] = value;
+            largest = largest.max(value);
         }
-        for &k in cells {
-            values[local(k)] = if self.w.mantissa[k] >= NO_DIGIT {
+        for (&k, &l) in cells.iter().zip(&local) {
+            values[l] = if self.w.mantissa[k] >= NO_DIGIT {
                 self.w.at_scale(k, scale).clamp(0.0, largest)
             } else {
                 0.0
@@ -794,7 +801,7 @@ impl<'a> Levels<'a> {
         let stats =
             multigrid::solve_rows(&rows, &unknown, &mut values, self.tolerance, MAX_ITERATIONS);
         Solved {
-            values: cells.iter().map(|&k| values[local(k)]).collect(),
+            values: local.iter().map(|&l| values[l]).collect(),
             scale,
             iterations: stats.iterations,
             relative_residual: stats.relative_residual,
