@@ -291,7 +291,7 @@ struct Levels<'a> {
     /// The number of the part of the band a cell is in (in the band; see [`PartSearch`]).
     /// Atomic (relaxed loads and stores, plain ones on x86) so that a part's solve can read its
     /// cells' marks while the search goes on numbering the next parts' (see
-    /// [`Levels::run_level`]).
+    /// [`Levels::search_and_solve`]).
     part: Vec<AtomicU32>,
     /// A band cell's index in its part (set with `part` by [`PartSearch`]).
     slot: Vec<AtomicU32>,
@@ -481,7 +481,8 @@ impl<'a> Levels<'a> {
         let (mut band, margin) = self.band_cells(lowest);
         // The band's parts, and meanwhile its tail, when every pending cell left beyond it fits
         // in as many cells again: most levels' rest does not, and the parts found without it
-        // stand.
+        // stand. Then they are solved; a large band without a tail has them solved as the
+        // search finds them (the results are the same).
         let rest = self.pending_count - band.len();
         let pipelined = self.pipelined.is_some() && band.len() >= PARALLEL_CELLS;
         let (parts, results) = if rest <= band.len() || !pipelined {
@@ -662,15 +663,11 @@ impl<'a> Levels<'a> {
     /// The searches for this level's band's parts and for its tail, each with the marks it
     /// reads and writes (apart, so that they can run at once).
     fn searches(&mut self) -> (PartSearch<'_>, TailSearch<'_>) {
-        let parts = PartSearch {
-            grid: self.grid,
-            band: &self.band,
-            level: self.level,
-            max_band: self.max_band,
-            slot: &self.slot,
-            part: &self.part,
-            first: self.numbered + 1,
-        };
+        let parts = PartSearch::of(
+            (self.grid, &self.band),
+            (&self.part, &self.slot),
+            (self.level, self.max_band, self.numbered),
+        );
         let tail = TailSearch {
             grid: self.grid,
             pending: &self.pending,
@@ -683,15 +680,11 @@ impl<'a> Levels<'a> {
 
     /// The search for this level's band's parts alone.
     fn part_search(&self) -> PartSearch<'_> {
-        PartSearch {
-            grid: self.grid,
-            band: &self.band,
-            level: self.level,
-            max_band: self.max_band,
-            slot: &self.slot,
-            part: &self.part,
-            first: self.numbered + 1,
-        }
+        PartSearch::of(
+            (self.grid, &self.band),
+            (&self.part, &self.slot),
+            (self.level, self.max_band, self.numbered),
+        )
     }
 
     /// Solves a part of the band (its cells are in the order of their slots), with the
@@ -887,7 +880,25 @@ struct PartSearch<'a> {
     first: u32,
 }
 
-impl PartSearch<'_> {
+impl<'a> PartSearch<'a> {
+    /// The search of the band marked `level` in `band`, with the widest direct solve
+    /// `max_band`, numbering parts on from the `numbered` parts before.
+    fn of(
+        (grid, band): (&'a Grid, &'a [u32]),
+        (part, slot): (&'a [AtomicU32], &'a [AtomicU32]),
+        (level, max_band, numbered): (u32, usize, u32),
+    ) -> Self {
+        Self {
+            grid,
+            band,
+            level,
+            max_band,
+            slot,
+            part,
+            first: numbered + 1,
+        }
+    }
+
     /// The parts of `band` (the cells whose mark is `level`), setting each cell's part number
     /// and slot, handed to `found` one by one as each is complete.
     fn run(&self, band: &[usize], mut found: impl FnMut(Part)) {
