@@ -1142,6 +1142,18 @@ mod tests {
         }
     }
 
+    /// `W` of the free cell `target` after its first solve (to 1e-12), and the cells that
+    /// solve leaves pending for the nested levels.
+    fn after_first_solve(grid: &Grid, reachable: &[bool], target: usize) -> (ScaledW, Vec<bool>) {
+        let mut unknown = reachable.to_vec();
+        unknown[target] = false;
+        let mut w = vec![0.0; grid.len()];
+        w[target] = 1.0;
+        multigrid::solve(grid, &unknown, &mut w, 1e-12, MAX_ITERATIONS);
+        let pending = deep_cells(grid, &unknown, &w, DEPTH_STEP);
+        (ScaledW::from_plain(w), pending)
+    }
+
     /// A straight corridor 20 cells wide and 600 long, from a target at one end: `W` falls by
     /// about `e^(−π/21)` per cell, to 1e-38 at the other. With a band of 48 its parts are
     /// solved directly (no CG iteration); with [`MAX_BAND`] (12) by multigrid, and the field
@@ -1155,13 +1167,7 @@ mod tests {
         let reachable = reachable_from(&grid, &blocked, (2, 12));
         let target = grid.index(2, 12);
         let with = |max_band: usize| {
-            let mut unknown = reachable.clone();
-            unknown[target] = false;
-            let mut w = vec![0.0; grid.len()];
-            w[target] = 1.0;
-            multigrid::solve(&grid, &unknown, &mut w, 1e-12, MAX_ITERATIONS);
-            let pending = deep_cells(&grid, &unknown, &w, DEPTH_STEP);
-            let mut w = ScaledW::from_plain(w);
+            let (mut w, pending) = after_first_solve(&grid, &reachable, target);
             let stats = solve_levels(&grid, pending, &mut w, (1e-12, max_band), &Stop::Never);
             (w, stats)
         };
@@ -1194,13 +1200,7 @@ mod tests {
         let reachable = reachable_from(&grid, &blocked, (1, 240));
         let target = grid.index(1, 240);
         let with = |pipelined: bool| {
-            let mut unknown = reachable.clone();
-            unknown[target] = false;
-            let mut w = vec![0.0; grid.len()];
-            w[target] = 1.0;
-            multigrid::solve(&grid, &unknown, &mut w, 1e-12, MAX_ITERATIONS);
-            let pending = deep_cells(&grid, &unknown, &w, DEPTH_STEP);
-            let mut w = ScaledW::from_plain(w);
+            let (mut w, pending) = after_first_solve(&grid, &reachable, target);
             let params = (1e-12, MAX_BAND);
             let (stats, levels) =
                 run_levels(&grid, pending, &mut w, params, &Stop::Never, pipelined);
