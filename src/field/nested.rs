@@ -255,6 +255,11 @@ struct Part {
     number: u32,
 }
 
+/// `Levels::dist` of a band's cells on the margin's last layer, the only ones that can touch
+/// the cut: never a step count (each below the number of cells) nor a tail search's mark
+/// (`u32::MAX` less a level, from 1).
+const LAST_LAYER: u32 = u32::MAX;
+
 /// A part solved, with its resolved cells and whether the cut kept resolved cells out (see
 /// [`Levels::resolved`]).
 type Outcome = (Solved, (Vec<usize>, bool));
@@ -285,8 +290,8 @@ struct Levels<'a> {
     frontier: Vec<usize>,
     /// `band[k] == level` when cell `k` is in this level's band.
     band: Vec<u32>,
-    /// Steps from the accepted cells (in the band); beyond it, the tail search's marks (see
-    /// [`TailSearch`]).
+    /// Steps from the accepted cells (in the band), [`LAST_LAYER`] on the margin's last layer;
+    /// beyond the band, the tail search's marks (see [`TailSearch`]).
     dist: Vec<u32>,
     /// The number of the part of the band a cell is in (in the band; see [`PartSearch`]).
     /// Atomic (relaxed loads and stores, plain ones on x86) so that a part's solve can read its
@@ -657,6 +662,12 @@ impl<'a> Levels<'a> {
             band.extend_from_slice(&next);
             layer = next;
         }
+        // Only the margin's last layer can touch the cut (every pending neighbour of a cell
+        // before it is in the band): marked so that a part's cells next to the cut are found
+        // among those alone (see `Levels::resolved`).
+        for &k in &layer {
+            self.dist[k] = LAST_LAYER;
+        }
         (band, layer)
     }
 
@@ -813,8 +824,8 @@ impl<'a> Levels<'a> {
         let mut near_cut = vec![false; cells.len()];
         let mut layer: Vec<usize> = (0..cells.len())
             .filter(|&s| {
-                self.neighbours(cells[s])
-                    .any(|m| self.pending[m] && !self.in_band(m))
+                self.dist[cells[s]] == LAST_LAYER
+                    && (self.neighbours(cells[s])).any(|m| self.pending[m] && !self.in_band(m))
             })
             .collect();
         for &s in &layer {
