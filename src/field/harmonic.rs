@@ -548,6 +548,7 @@ fn first_box(grid: &Grid, unknown: &[bool], target: &[usize], side: usize) -> Op
 
 /// How the first solve went: its CG iterations and final residual, how many solves it took
 /// (two when a box was too small), their unknown cells, and whether the box's was kept.
+#[derive(Default)]
 struct FirstSolve {
     iterations: usize,
     relative_residual: f64,
@@ -568,13 +569,7 @@ fn first_solve(
     w: &mut [f64],
     tolerance: f64,
 ) -> (FirstSolve, Vec<bool>) {
-    let mut tried = FirstSolve {
-        iterations: 0,
-        relative_residual: 0.0,
-        solves: 0,
-        cells: 0,
-        on_box: false,
-    };
+    let mut tried = FirstSolve::default();
     let count = |cells: &[bool]| cells.iter().filter(|&&u| u).count();
     if let Some(boxed) = boxed {
         let start: Vec<f64> = (0..w.len()).filter(|&k| boxed[k]).map(|k| w[k]).collect();
@@ -597,10 +592,9 @@ fn first_solve(
         }
         tried = FirstSolve {
             iterations: stats.iterations,
-            relative_residual: 0.0,
             solves: 1,
             cells: count(boxed),
-            on_box: false,
+            ..FirstSolve::default()
         };
     }
     let stats = multigrid::solve(grid, unknown, w, tolerance, MAX_ITERATIONS);
@@ -724,10 +718,7 @@ mod tests {
         let (_, whole) = solved_after(&grid, (&unknown, &w), None);
         let far = whole.log2(grid.index(398, 2)) * std::f64::consts::LOG10_2;
         assert!(far < -100.0, "log10 W at the end: {far}");
-        for k in (0..grid.len()).filter(|&k| unknown[k]) {
-            let (a, b) = (on_box.log2(k), whole.log2(k));
-            assert!((a - b).abs() < 1e-5, "cell {k}: log2 W {a} against {b}");
-        }
+        crate::field::scaled::assert_same_to_six_digits(&on_box, &whole, &unknown);
     }
 
     /// In an open room `W` is above the depth everywhere, and a box 32 cells wide in a grid

@@ -102,6 +102,16 @@ impl ScaledW {
     }
 }
 
+/// Checks that `a` and `b` agree on each of `cells` to six digits (`log2 W` within 1e-5),
+/// at any depth: two solves of one field.
+#[cfg(test)]
+pub(crate) fn assert_same_to_six_digits(a: &ScaledW, b: &ScaledW, cells: &[bool]) {
+    for k in (0..cells.len()).filter(|&k| cells[k]) {
+        let (a, b) = (a.log2(k), b.log2(k));
+        assert!((a - b).abs() < 1e-5, "cell {k}: log2 W {a} against {b}");
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
