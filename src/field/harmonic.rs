@@ -287,20 +287,6 @@ impl HarmonicField {
         })
     }
 
-    /// This field (with a wide window, from [`HarmonicField::with_wide_window`]) keeping the
-    /// coarse window of `ordinary`'s window (the ordinary window of the same replan, which
-    /// turned back), for the next replan's ordinary window to reuse as it would had `ordinary`
-    /// been kept. Without a window on either, this field as it is.
-    pub(crate) fn keeping_coarse_of(self, ordinary: &HarmonicField) -> Self {
-        let window = match (self.window, &ordinary.window) {
-            (Some(wide), Some(ordinary)) => Some(Arc::new(
-                Arc::unwrap_or_clone(wide).keeping_coarse_of(ordinary),
-            )),
-            (window, _) => window,
-        };
-        Self { window, ..self }
-    }
-
     /// This field without its window: the field of the walls alone.
     pub fn without_window(&self) -> Self {
         Self {

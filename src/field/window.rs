@@ -71,11 +71,6 @@ pub struct Window {
     /// The coarse window that gave the window's edge, if any (shared with the next replans,
     /// which may reuse it: see [`COARSE_REUSE`]).
     coarse: Option<Arc<Coarse>>,
-    /// A wide window's ([`Reach::Whole`]): the coarse window of the ordinary window made at
-    /// the same replan, which turned back and gave way to this one (see
-    /// [`Window::keeping_coarse_of`]). The next replan's ordinary window may reuse it, as it
-    /// would had that ordinary window been kept.
-    ordinary: Option<Arc<Coarse>>,
     /// Conjugate gradient iterations of the solve (the coarse window's too, when it was
     /// solved for this one).
     pub iterations: usize,
@@ -294,13 +289,16 @@ impl Window {
         // asks when the window keeps turning back (128 robots on the 1.8 m circle: 4,876 of
         // 5,371 wide windows 0.1 s after another), and reusing it there took that crowd from
         // 1.87 to 1.38 s of wall time per simulated second, every robot arriving, no contact.
+        // An ordinary window after a wide one solves its coarse window anew, though the
+        // ordinary window of the wide one's replan (which turned back) solved one too: kept
+        // in the wide window and reused, it saved 4,485 of 12,298 coarse solves in the first
+        // 30 s of the shipped 128 robots (the whole run 163.6 → 150.5 s; 160.4 → 159.2 s on
+        // `scripts/crowds.py`'s seed 1), but it steered worse just after a turn back, where a
+        // fresh view of the crowd matters: 64 robots (`crowds.py`, seeds 0–5) last settled
+        // 44.7 → 46.7 s on average (later on four seeds, as late on two) for 2 % less time,
+        // and of the shipped 128, 111 reached in the 94 s against 115.
         let serves = if whole { 0.25 * half } else { 0.25 * reach };
-        // (An ordinary window after a wide one finds the ordinary coarse window of that replan
-        // kept in it: see `Window::ordinary`.)
-        let last_coarse = previous.and_then(|p| match &p.coarse {
-            Some(c) if c.whole && !whole => p.ordinary.as_ref(),
-            c => c.as_ref(),
-        });
+        let last_coarse = previous.and_then(|p| p.coarse.as_ref());
         let reusable = last_coarse.filter(|c| {
             whole == c.whole
                 && c.reused < COARSE_REUSE
@@ -405,23 +403,9 @@ impl Window {
             interior,
             discs: discs.len(),
             coarse,
-            ordinary: None,
             iterations: iterations + coarse_iterations,
             solve_time: started.elapsed(),
         })
-    }
-
-    /// This wide window, keeping the coarse window of `ordinary`, the ordinary window made at
-    /// the same replan that turned back and gave way to it, for the next replan's ordinary
-    /// window to reuse ([`COARSE_REUSE`]). Without it, an agent whose windows keep turning
-    /// back solved a coarse window for the ordinary window at every replan, and threw it away
-    /// (128 robots on the 1.8 m circle, first 30 s: 12,298 coarse windows of 12,532 cells
-    /// solved for 38,364 ordinary windows, 36 of 139 s of CPU).
-    pub(super) fn keeping_coarse_of(self, ordinary: &Window) -> Self {
-        Self {
-            ordinary: ordinary.coarse.clone(),
-            ..self
-        }
     }
 
     /// The window's field.
@@ -765,8 +749,7 @@ mod tests {
     /// A wide window's coarse window covers the whole grid and serves the next wide window,
     /// never an ordinary one (the field among the others over the whole grid, held as the edge
     /// of ordinary windows, milled crossing flows about for good: see the commit that reverted
-    /// that reuse); an ordinary coarse window serves the next ordinary replan, through a wide
-    /// window that keeps it too.
+    /// that reuse); an ordinary coarse window serves the next ordinary replan.
     #[test]
     fn a_wide_windows_coarse_window_covers_the_grid_and_serves_only_wide_windows() {
         let (world, walls) = circle_16();
@@ -807,22 +790,6 @@ mod tests {
             .unwrap();
         assert!(Arc::ptr_eq(&solved(&next), &solved(&again)));
         assert_eq!(coarse(&again).reused, 1);
-        // A wide window keeping the coarse window of its replan's ordinary window (which
-        // turned back) still serves wide windows its own, and the next ordinary window the
-        // ordinary one.
-        let kept = wide_again.keeping_coarse_of(&next);
-        assert!(Arc::ptr_eq(&solved(&wide), &solved(&kept)));
-        let after = kept
-            .with_window(agent, agent.start, &others, &settings)
-            .unwrap();
-        assert!(Arc::ptr_eq(&solved(&next), &solved(&after)));
-        assert_eq!(coarse(&after).reused, 1);
-        let wide_after = kept
-            .with_wide_window(agent, agent.start, &others, &settings)
-            .unwrap()
-            .unwrap();
-        assert!(Arc::ptr_eq(&solved(&wide), &solved(&wide_after)));
-        assert_eq!(coarse(&wide_after).reused, 2);
     }
 
     /// A replan that sets the very problem of the last one (the same discs, the agent where it

@@ -695,7 +695,7 @@ impl AgentRun {
                     // livelocked when it decided there).
                     Ok(window) if turns_back(field, &window, plan.x) => {
                         match walls.with_wide_window(&self.agent, x, others, &world.field) {
-                            Some(Ok(wide)) => Ok(wide.keeping_coarse_of(&window)),
+                            Some(Ok(wide)) => Ok(wide),
                             _ => whole_among_others(others),
                         }
                     }
