@@ -576,24 +576,20 @@ impl<'a> Levels<'a> {
         let search = self.part_search();
         let (sender, found) = std::sync::mpsc::channel();
         rayon::scope(|s| {
-            let mut index = 0;
             search.run(band, |part| {
                 let sender = sender.clone();
                 s.spawn(move |_| {
                     let result = self.solve_and_resolve(&part, lowest);
                     // The receiver outlives the scope.
-                    let _ = sender.send((index, part, result));
+                    let _ = sender.send((part, result));
                 });
-                index += 1;
             });
         });
         drop(sender);
+        // The search numbers the parts in the order it finds them.
         let mut found: Vec<_> = found.into_iter().collect();
-        found.sort_unstable_by_key(|(index, ..)| *index);
+        found.sort_unstable_by_key(|(part, _)| part.number);
         found
-            .into_iter()
-            .map(|(_, part, result)| (part, result))
-            .collect()
     }
 
     /// A part solved, and its resolved cells. The parts are disjoint and each reads only the
