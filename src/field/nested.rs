@@ -65,18 +65,30 @@ pub const FLOOR: f64 = 1e-11;
 pub const CORE_STEPS: u32 = 8;
 /// The factor a band's core grows by after a level the cut limited, once the extent has first
 /// been enough. A level accepts what the depth allows whatever the extent beyond it, so an
-/// extent past the cut's reach only costs: in steps of 1.5 and 0.75 the extent settles near
-/// the least that the cut does not limit, where doubling and halving swung it between too
-/// short and twice too long. (Doubling at first, until the extent is first enough, reaches a
-/// wide region in as few levels as before: every field that is never depth-limited solves
-/// exactly as it did.) Measured on the rooms map's longest field (2560² cells, 626 decades
-/// deep): doubling and halving took 141 levels with the core swinging 64 → 128 → 256 steps
-/// and back, 22.7 M cells solved, 20.6–22.0 s; these, 130 levels, 15.6 M cells, 13.2 s.
+/// extent past the cut's reach only costs: the extent tracks the least that the cut does not
+/// limit, a little above it after each cut-limited level and a little below it after a few
+/// others, so that few cells beyond what the depth allows are solved. (Doubling at first,
+/// until the extent is first enough, reaches a wide region in as few levels as before: every
+/// field that is never depth-limited solves exactly as it did.)
+///
+/// Measured on the rooms map (2560² cells; its own field and seven scenarios spread over its
+/// scenario file, 5–544 decades deep; `nadf field`):
+/// - doubling and halving swung the core 64 → 128 → 256 steps and back: 141 levels and
+///   22.7 M cells for the longest field;
+/// - 1.5 and 0.75 swung it between about 85 and 144 steps, and two thirds of the cells solved
+///   ended below what the depth allows (8.5 M of the longest field's 13.2 M): 13.0–14.3 M
+///   cells a field, 4.9–5.5 s of CPU;
+/// - 1.1 and 0.95 (these): 11.4–12.1 M cells a field (14 % fewer in all), 4.2–4.5 s of CPU;
+///   the longest field in 2.78–2.83 s against 3.18–4.12 s (five alternating runs), every
+///   cell within 3.4e-6 relative of 1.5 and 0.75's;
+/// - gentler still gained little there and cost the corridors of `maze.toml`: 1.05 and 0.98
+///   solved 196 k cells against 151 k (these: 163 k).
+///
 /// Growing by 1.5 from the start cost `map-depot` 451 k cells against 325 k (0.30 s against
 /// 0.22 s).
-pub const CORE_GROWTH: f64 = 1.5;
+pub const CORE_GROWTH: f64 = 1.1;
 /// The factor a band's core shrinks by after a level the depth limited (see [`CORE_GROWTH`]).
-pub const CORE_SHRINK: f64 = 0.75;
+pub const CORE_SHRINK: f64 = 0.95;
 /// The largest extent of a band's core, in steps.
 pub const MAX_CORE_STEPS: u32 = 1 << 16;
 /// An estimate of at least this fraction of its solve's scale is reliable enough to extend a
@@ -1187,22 +1199,22 @@ mod tests {
         crate::field::scaled::assert_same_to_six_digits(&direct, &by_multigrid, &reachable);
     }
 
-    /// A room of 480 × 480 cells cut by four walls with a door of two cells each, at
+    /// A room of 576 × 576 cells cut by five walls with a door of two cells each, at
     /// alternate ends: bands of tens of thousands of cells. Solving each level's parts as the
     /// search finds them gives the field of searching first and solving after, to the bit.
     #[test]
     fn parts_solved_as_they_are_found_give_the_field_of_parts_solved_after() {
-        let grid = Grid::covering([480.0, 480.0], 1.0);
+        let grid = Grid::covering([576.0, 576.0], 1.0);
         let blocked: Vec<bool> = (0..grid.len())
             .map(|k| {
                 let (i, j) = (k % grid.nx, k / grid.nx);
                 let wall = i % 96 == 95;
-                let door = if (i / 96) % 2 == 0 { j < 2 } else { j >= 478 };
+                let door = if (i / 96) % 2 == 0 { j < 2 } else { j >= 574 };
                 wall && !door
             })
             .collect();
-        let reachable = reachable_from(&grid, &blocked, (1, 240));
-        let target = grid.index(1, 240);
+        let reachable = reachable_from(&grid, &blocked, (1, 288));
+        let target = grid.index(1, 288);
         let with = |pipelined: bool| {
             let (mut w, pending) = after_first_solve(&grid, &reachable, target);
             let params = (1e-12, MAX_BAND);
@@ -1217,7 +1229,7 @@ mod tests {
         let bits = |w: &ScaledW| (w.mantissa.iter().map(|m| m.to_bits())).collect::<Vec<_>>();
         assert!(bits(&after) == bits(&found), "the fields differ");
         assert_eq!(after.exponent, found.exponent);
-        assert!(after.log10(grid.index(478, 240)) < -20.0);
+        assert!(after.log10(grid.index(574, 288)) < -20.0);
     }
 
     /// The field of the serpentine from the target `(1, 1)`, its nested levels stopping as
