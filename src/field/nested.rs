@@ -72,15 +72,15 @@ pub const CORE_STEPS: u32 = 8;
 /// field that is never depth-limited solves exactly as it did.)
 ///
 /// Measured on the rooms map (2560² cells; its own field and seven scenarios spread over its
-/// scenario file, 5–544 decades deep; `nadf field`):
+/// scenario file, `1 − V` at their starts from 4e-6 to 1e-544; `nadf field`):
 /// - doubling and halving swung the core 64 → 128 → 256 steps and back: 141 levels and
 ///   22.7 M cells for the longest field;
 /// - 1.5 and 0.75 swung it between about 85 and 144 steps, and two thirds of the cells solved
 ///   ended below what the depth allows (8.5 M of the longest field's 13.2 M): 13.0–14.3 M
 ///   cells a field, 4.9–5.5 s of CPU;
 /// - 1.1 and 0.95 (these): 11.4–12.1 M cells a field (14 % fewer in all), 4.2–4.5 s of CPU;
-///   the longest field in 2.78–2.83 s against 3.18–4.12 s (five alternating runs), every
-///   cell within 3.4e-6 relative of 1.5 and 0.75's;
+///   the longest field in 2.68–2.92 s against 3.21–3.84 s (medians 2.75 and 3.31 s, five
+///   alternating runs), every cell within 3.4e-6 relative of 1.5 and 0.75's;
 /// - gentler still gained little there and cost the corridors of `maze.toml`: 1.05 and 0.98
 ///   solved 196 k cells against 151 k (these: 163 k).
 ///
