@@ -32,6 +32,8 @@ import sys
 import tempfile
 import time
 
+from machine import describe
+
 ROBOT = 'radius = 0.3\ncontroller = {{ kind = "{kind}", {gains}speed_limit = 2.0{bare} }}\n'
 
 # Whether the robots run without the clearance envelope (`--bare`).
@@ -153,6 +155,7 @@ def main():
     global BARE
     BARE = args.bare
     extra = [a for s in args.set for a in ("--set", s)]
+    print(describe())
     print("world                      ctrl  robots reached contacts closest_m deadlocked livelocked unreached_d/l/-  last_settle_s  wall/sim")
     for kind in args.kinds:
         for n in args.robots:

@@ -28,6 +28,8 @@ import numpy as np
 import pyamg
 import scipy.sparse as sp
 
+from machine import describe
+
 
 def nadf_field(nadf, world, sets, out):
     cmd = [nadf, "field", world, "--npy", out]
@@ -80,6 +82,7 @@ def main():
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--tol", type=float, default=1e-10)
     args = p.parse_args()
+    print(describe())
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "v.npy")
         runs = [nadf_field(args.nadf, args.world, args.set, out) for _ in range(args.repeat)]
