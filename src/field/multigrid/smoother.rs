@@ -259,7 +259,9 @@ impl Level {
         let (k, n) = self.row(j);
         let keep = &keep[(c + j) % 2][self.span(j)];
         let x = &mut x[k - origin..k - origin + n];
-        let (b, d) = (&b[k..k + n], &self.inv_diag[k..k + n]);
+        // `keep` is `n` long already (the span's pattern), but the compiler cannot tell: sliced
+        // to `n` as the others are, the loop has no bounds check and is vectorized.
+        let (b, d, keep) = (&b[k..k + n], &self.inv_diag[k..k + n], &keep[..n]);
         for i in 0..n {
             x[i] = flushed((1.0 - keep[i]) * d[i] * b[i]);
         }
