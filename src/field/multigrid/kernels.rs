@@ -64,16 +64,6 @@ pub struct At {
 }
 
 impl At {
-    /// The runs `i` cells further along their rows.
-    #[inline(always)]
-    pub fn plus(self, i: usize) -> Self {
-        Self {
-            down: self.down + i,
-            mid: self.mid + i,
-            up: self.up + i,
-        }
-    }
-
     /// The same runs in a slice of the vector that starts at index `origin`.
     #[inline(always)]
     pub fn from(self, origin: usize) -> Self {

@@ -2,7 +2,7 @@
 //! residual of a row. Every function here runs inside [`super::kernels::wide`], so each is
 //! `#[inline(always)]` (the inlining rule of `kernels.rs`).
 
-use super::kernels::{At, Neighbourhood, flushed};
+use super::kernels::{Neighbourhood, flushed};
 use super::level::{Level, Stencil};
 
 /// Cells a short row's update computes at once: one AVX2 register of f32.
@@ -11,95 +11,99 @@ const LANES: usize = 8;
 /// Rows at least this long are updated through a buffer (see [`in_place`]).
 const LONG_ROW: usize = 256;
 
-/// Gauss-Seidel's new values `out` of the cells at `at` (row position `i`, for `keep`) on the
-/// finest level's uniform stencil, from `x` (which starts at index `origin`); `keep`'s cells
-/// keep their value.
+/// Gauss-Seidel's new values `out` of cells `i .. i + out.len()` of a row on the finest
+/// level's uniform stencil. `row` holds the row's old values from the cell before the first
+/// (so cell `l`'s west, itself and its east are `row[l]`, `row[l + 1]`, `row[l + 2]`); `down`,
+/// `up`, `b`, `d` and `keep` are the row's neighbours below and above, right-hand side,
+/// `1 / diagonal` and keep pattern, each sliced to the row. `keep`'s cells keep their value.
 #[inline(always)]
 fn uniform(
     out: &mut [f32],
-    (x, origin): (&[f32], usize),
+    row: &[f32],
+    (down, up): (&[f32], &[f32]),
     (b, d, keep): (&[f32], &[f32], &[f32]),
-    (at, i): (At, usize),
+    i: usize,
 ) {
     let n = out.len();
-    let o = at.mid;
-    let x = Neighbourhood::of(x, at.from(origin), n);
-    let (b, d, keep) = (&b[o..o + n], &d[o..o + n], &keep[i..i + n]);
+    let w = &row[i..i + n + 2];
+    let (west, mid, east) = (&w[..n], &w[1..n + 1], &w[2..n + 2]);
+    let (down, up) = (&down[i..i + n], &up[i..i + n]);
+    let (b, d, keep) = (&b[i..i + n], &d[i..i + n], &keep[i..i + n]);
     for l in 0..n {
-        let new = d[l] * (b[l] + x.west[l] + x.east[l] + x.up[l] + x.down[l]);
-        out[l] = flushed(keep[l] * x.mid[l] + (1.0 - keep[l]) * new);
+        let new = d[l] * (b[l] + west[l] + east[l] + up[l] + down[l]);
+        out[l] = flushed(keep[l] * mid[l] + (1.0 - keep[l]) * new);
     }
 }
 
-/// [`uniform`] on a coarse level's stencil of `east` and `north` couplings.
+/// [`uniform`] on a coarse level's stencil: `east` holds the row's east couplings from the
+/// cell before the first (cell `l`'s west and east couplings are `east[l]` and
+/// `east[l + 1]`), `north` and `north_down` the north couplings of the row and of the row
+/// below.
 #[inline(always)]
 fn coefficients(
     out: &mut [f32],
-    (x, origin): (&[f32], usize),
+    row: &[f32],
+    (down, up): (&[f32], &[f32]),
     (b, d, keep): (&[f32], &[f32], &[f32]),
-    (east, north): (&[f32], &[f32]),
-    (at, i): (At, usize),
+    (east, north, north_down): (&[f32], &[f32], &[f32]),
+    i: usize,
 ) {
     let n = out.len();
-    let o = at.mid;
-    let x = Neighbourhood::of(x, at.from(origin), n);
-    let (b, d, keep) = (&b[o..o + n], &d[o..o + n], &keep[i..i + n]);
-    let (e, no) = (
-        Neighbourhood::of(east, at, n),
-        Neighbourhood::of(north, at, n),
-    );
+    let w = &row[i..i + n + 2];
+    let (west, mid, east_x) = (&w[..n], &w[1..n + 1], &w[2..n + 2]);
+    let (down, up) = (&down[i..i + n], &up[i..i + n]);
+    let (b, d, keep) = (&b[i..i + n], &d[i..i + n], &keep[i..i + n]);
+    let e = &east[i..i + n + 1];
+    let (e_west, e_mid) = (&e[..n], &e[1..n + 1]);
+    let (no_mid, no_down) = (&north[i..i + n], &north_down[i..i + n]);
     for l in 0..n {
         let new = d[l]
             * (b[l]
-                + e.mid[l] * x.east[l]
-                + e.west[l] * x.west[l]
-                + no.mid[l] * x.up[l]
-                + no.down[l] * x.down[l]);
-        out[l] = flushed(keep[l] * x.mid[l] + (1.0 - keep[l]) * new);
+                + e_mid[l] * east_x[l]
+                + e_west[l] * west[l]
+                + no_mid[l] * up[l]
+                + no_down[l] * down[l]);
+        out[l] = flushed(keep[l] * mid[l] + (1.0 - keep[l]) * new);
     }
 }
 
-/// Writes the new values of the `n` cells of a row from index `k`: `new(out, x, i)`
-/// computes those of cells `i .. i + out.len()` of the row from the old values around them.
+/// Writes the new values of the `n` cells of a row: `row` holds them with a cell either side
+/// (`n + 2` values), and `new(out, row, i)` computes those of cells `i .. i + out.len()` from
+/// the old values around them.
 ///
 /// A short row is updated in place, [`LANES`] cells at a time, each chunk's new values stored
 /// only after the next chunk has read its old ones: every read sees the old row, as through a
 /// buffer (the same values, to the bit), without copying the buffer back, a call to `memcpy`
 /// per row and pass that was 7 % of a crowd's time on the windows' rows of 61 cells. The last
 /// chunk overlaps the one before it when `LANES` does not divide `n`; a cell both compute gets
-/// the same value from both. A long row, or one shorter than `LANES`, is computed into the
-/// buffer `t` and copied back (on a long row the copy's call costs nothing, and the loop over
-/// the whole row is faster than chunks: measured, 1024² room, 8 % slower in chunks).
+/// the same value from both. Every chunk starts at most `n − LANES` cells in, which the
+/// compiler sees, so its slices of the inputs, each cut to the row once ([`Level::relax_row`]),
+/// need no bounds check. (When each chunk sliced the level's whole vectors, its 16 checks were
+/// most of its instructions: without them a crowd's run takes 16 % less time, the rooms map's
+/// longest field 12 % and the 1024² room's solve 20 %, every value the same.) A long row,
+/// or one shorter than `LANES`, is computed into the buffer `t` and copied back (on a long row
+/// the copy's call costs nothing, and the loop over the whole row is faster than chunks:
+/// measured, 1024² room, 8 % slower in chunks).
 #[inline(always)]
-fn in_place(
-    x: &mut [f32],
-    (k, n): (usize, usize),
-    t: &mut [f32],
-    new: impl Fn(&mut [f32], &[f32], usize),
-) {
+fn in_place(row: &mut [f32], t: &mut [f32], new: impl Fn(&mut [f32], &[f32], usize)) {
+    let n = row.len() - 2;
     if !(LANES..LONG_ROW).contains(&n) {
-        new(&mut t[..n], x, 0);
-        x[k..k + n].copy_from_slice(&t[..n]);
+        new(&mut t[..n], row, 0);
+        row[1..n + 1].copy_from_slice(&t[..n]);
         return;
     }
-    let next_at = |at: usize| {
-        if at + 2 * LANES <= n {
-            at + LANES
-        } else {
-            n - LANES
-        }
-    };
+    let last = n - LANES;
     let mut pending = [0.0; LANES];
-    new(&mut pending, x, 0);
+    new(&mut pending, row, 0);
     let mut at = 0;
-    while at + LANES < n {
-        let i = next_at(at);
+    while at < last {
+        let i = (at + LANES).min(last);
         let mut next = [0.0; LANES];
-        new(&mut next, x, i);
-        x[k + at..k + at + LANES].copy_from_slice(&pending);
+        new(&mut next, row, i);
+        row[at + 1..at + 1 + LANES].copy_from_slice(&pending);
         (pending, at) = (next, i);
     }
-    x[k + at..k + at + LANES].copy_from_slice(&pending);
+    row[at + 1..at + 1 + LANES].copy_from_slice(&pending);
 }
 
 /// The rows of a level that one wavefront covers ([`Level::sweep`]).
@@ -211,31 +215,45 @@ impl Level {
     ) {
         let (at, cols) = self.run(j);
         let n = cols.len();
-        let keep = &keep[(c + j) % 2][cols];
-        let d = &self.inv_diag;
+        if n == 0 {
+            return;
+        }
+        let keep = &keep[(c + j) % 2][cols][..n];
+        // The rows below, the row and the rows above, apart: the update writes only the row.
+        let (first, next) = (self.row_start(j), self.row_start(j + 1));
+        let (below, rest) = x.split_at_mut(first - origin);
+        let (here, above) = rest.split_at_mut(next - first);
+        let row = &mut here[at.mid - 1 - first..at.mid + n + 1 - first];
+        let down = &below[at.down - origin..at.down - origin + n];
+        let up = &above[at.up - next..at.up - next + n];
+        let (b, d) = (&b[at.mid..at.mid + n], &self.inv_diag[at.mid..at.mid + n]);
         match &self.stencil {
             Stencil::Uniform => in_place(
-                x,
-                (at.mid - origin, n),
+                row,
                 t,
                 #[inline(always)]
-                |out, x, i| uniform(out, (x, origin), (b, d, keep), (at.plus(i), i)),
+                |out, row, i| uniform(out, row, (down, up), (b, d, keep), i),
             ),
-            Stencil::Coefficients { east, north, .. } => in_place(
-                x,
-                (at.mid - origin, n),
-                t,
-                #[inline(always)]
-                |out, x, i| {
-                    coefficients(
-                        out,
-                        (x, origin),
-                        (b, d, keep),
-                        (east, north),
-                        (at.plus(i), i),
-                    )
-                },
-            ),
+            Stencil::Coefficients { east, north, .. } => {
+                let east = &east[at.mid - 1..at.mid + n];
+                let north_down = &north[at.down..at.down + n];
+                let north = &north[at.mid..at.mid + n];
+                in_place(
+                    row,
+                    t,
+                    #[inline(always)]
+                    |out, row, i| {
+                        coefficients(
+                            out,
+                            row,
+                            (down, up),
+                            (b, d, keep),
+                            (east, north, north_down),
+                            i,
+                        )
+                    },
+                )
+            }
         }
     }
 
