@@ -309,7 +309,10 @@ impl Hierarchy {
                                 // `Level::relax_row_from_zero`).
                                 for ((x, a), c) in cells.iter_mut().zip(active).zip(&expanded[..n])
                                 {
-                                    *x = flushed(*x + if *a != 0.0 { *c } else { 0.0 });
+                                    // `c` read on every cell, then selected (see
+                                    // `Level::residual_row`).
+                                    let c = *c;
+                                    *x = flushed(*x + if *a != 0.0 { c } else { 0.0 });
                                 }
                             },
                             #[inline(always)]

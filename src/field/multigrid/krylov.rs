@@ -328,7 +328,8 @@ impl Krylov {
                         let (row, c, scale) = (&row[..n], c, scale);
                         for i in 0..n {
                             x[i] += c * f64::from(q[i]);
-                            r[i] -= if d[i] != 0.0 { c * row[i] } else { 0.0 };
+                            let step = c * row[i];
+                            r[i] -= if d[i] != 0.0 { step } else { 0.0 };
                             out[i] = for_cycle(r[i], scale);
                         }
                         dots[j - rows.start] = dot(r, r);
