@@ -121,18 +121,27 @@ pub(super) fn polyline_distance(points: &[[f64; 2]], p: [f64; 2]) -> f64 {
     match points {
         [] => f64::INFINITY,
         [a] => (p - Vector2::from(*a)).norm(),
+        // The least squared distance, square-rooted once: the same value as the least of the
+        // segments' distances (the square root rounds monotonically), without a square root
+        // per segment, which was 3 % of the time of 128 robots yielding to each other.
         _ => (points.windows(2))
-            .map(|s| segment_distance(s[0], s[1], p))
-            .fold(f64::INFINITY, f64::min),
+            .map(|s| segment_distance_squared(s[0], s[1], p))
+            .fold(f64::INFINITY, f64::min)
+            .sqrt(),
     }
 }
 
 /// Distance from `p` to the segment from `a` to `b`, m.
 pub(super) fn segment_distance(a: [f64; 2], b: [f64; 2], p: Vector2<f64>) -> f64 {
+    segment_distance_squared(a, b, p).sqrt()
+}
+
+/// The square of [`segment_distance`], m².
+fn segment_distance_squared(a: [f64; 2], b: [f64; 2], p: Vector2<f64>) -> f64 {
     let (a, b) = (Vector2::from(a), Vector2::from(b));
     let ab = b - a;
     let t = ((p - a).dot(&ab) / ab.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-    (p - (a + ab * t)).norm()
+    (p - (a + ab * t)).norm_squared()
 }
 
 #[cfg(test)]
