@@ -76,11 +76,12 @@ fn coefficients(
 /// buffer (the same values, to the bit), without copying the buffer back, a call to `memcpy`
 /// per row and pass that was 7 % of a crowd's time on the windows' rows of 61 cells. The last
 /// chunk overlaps the one before it when `LANES` does not divide `n`; a cell both compute gets
-/// the same value from both. Every chunk starts at most `n − LANES` cells in, which the
-/// compiler sees, so its slices of the inputs, each cut to the row once ([`Level::relax_row`]),
-/// need no bounds check. (When each chunk sliced the level's whole vectors, its 16 checks were
-/// most of its instructions: without them a crowd's run takes 16 % less time, the rooms map's
-/// longest field 12 % and the 1024² room's solve 20 %, every value the same.) A long row,
+/// the same value from both. Every chunk starts at most `n − LANES` cells in, and its inputs
+/// are cut to the row once ([`Level::relax_row`]), so the compiler drops most of a chunk's
+/// bounds checks: 3 or 4 are left of 16, which were most of its instructions when each chunk
+/// sliced the level's whole vectors (without them a crowd's run takes 16 % less time, the
+/// rooms map's longest field 12 % and the 1024² room's solve 20 %, every value the same;
+/// cutting the inputs as `[k..][..n]` removes no more). A long row,
 /// or one shorter than `LANES`, is computed into the buffer `t` and copied back (on a long row
 /// the copy's call costs nothing, and the loop over the whole row is faster than chunks:
 /// measured, 1024² room, 8 % slower in chunks).
