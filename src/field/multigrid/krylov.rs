@@ -328,6 +328,8 @@ impl Krylov {
                         let (row, c, scale) = (&row[..n], c, scale);
                         for i in 0..n {
                             x[i] += c * f64::from(q[i]);
+                            // Computed on every cell, then selected (see
+                            // `Level::residual_row`): no masked loads.
                             let step = c * row[i];
                             r[i] -= if d[i] != 0.0 { step } else { 0.0 };
                             out[i] = for_cycle(r[i], scale);

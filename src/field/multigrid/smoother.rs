@@ -81,10 +81,10 @@ fn coefficients(
 /// bounds checks: 3 or 4 are left of 16, which were most of its instructions when each chunk
 /// sliced the level's whole vectors (without them a crowd's run takes 16 % less time, the
 /// rooms map's longest field 12 % and the 1024² room's solve 20 %, every value the same;
-/// cutting the inputs as `[k..][..n]` removes no more). A long row,
-/// or one shorter than `LANES`, is computed into the buffer `t` and copied back (on a long row
-/// the copy's call costs nothing, and the loop over the whole row is faster than chunks:
-/// measured, 1024² room, 8 % slower in chunks).
+/// cutting the inputs as `[k..][..n]` removes no more). A long row, or one shorter than
+/// `LANES`, is computed into the buffer `t` and copied back (on a long row the copy's call
+/// costs nothing, and the loop over the whole row is faster than chunks: measured, 1024² room,
+/// 8 % slower in chunks).
 #[inline(always)]
 fn in_place(row: &mut [f32], t: &mut [f32], new: impl Fn(&mut [f32], &[f32], usize)) {
     let n = row.len() - 2;
