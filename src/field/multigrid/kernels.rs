@@ -43,7 +43,7 @@ pub fn wide<R>(f: impl FnOnce() -> R) -> R {
         fn avx2<R>(f: impl FnOnce() -> R) -> R {
             f()
         }
-        if !PORTABLE.load(Ordering::Relaxed) && std::arch::is_x86_feature_detected!("avx2") {
+        if avx2_on() {
             // SAFETY: the processor supports AVX2, checked just above.
             return unsafe { avx2(f) };
         }
@@ -147,6 +147,40 @@ const FLUSH: f32 = 1e-30;
 #[inline(always)]
 pub fn flushed(v: f32) -> f32 {
     if v.abs() < FLUSH { 0.0 } else { v }
+}
+
+/// Whether [`wide`] takes the AVX2 path: the processor has AVX2 and [`set_portable`] has not
+/// switched it off. Code that calls AVX2 intrinsics itself ([`x86`]) checks it first.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn avx2_on() -> bool {
+    !PORTABLE.load(Ordering::Relaxed) && std::arch::is_x86_feature_detected!("avx2")
+}
+
+/// AVX2 forms of the building blocks, for a loop the compiler does not vectorize well on its
+/// own (see `smoother.rs`). Each is the scalar one on 8 lanes, to the bit.
+#[cfg(target_arch = "x86_64")]
+pub mod x86 {
+    use std::arch::x86_64::{
+        __m256, _CMP_NLT_UQ, _mm256_and_ps, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_set1_epi32,
+        _mm256_set1_ps,
+    };
+
+    /// [`super::flushed`] on each lane: `v`, or 0 (+0) where `|v|` is below the flush level;
+    /// a NaN is kept, as `|v| < FLUSH` is false for it.
+    ///
+    /// # Safety
+    /// The processor must have AVX2 ([`super::avx2_on`]). Not a `#[target_feature]` function,
+    /// which would not be inlined: it is inlined into [`super::wide`]'s AVX2 function.
+    #[inline(always)]
+    pub unsafe fn flushed(v: __m256) -> __m256 {
+        // SAFETY: the processor has AVX2 (the caller's contract).
+        unsafe {
+            let abs = _mm256_and_ps(v, _mm256_castsi256_ps(_mm256_set1_epi32(i32::MAX)));
+            let kept = _mm256_cmp_ps::<_CMP_NLT_UQ>(abs, _mm256_set1_ps(super::FLUSH));
+            _mm256_and_ps(v, kept)
+        }
+    }
 }
 
 /// `r · scale` rounded to f32 for the cycle, 0 when too small for f32 to hold at full precision.

@@ -2,6 +2,8 @@
 //! residual of a row. Every function here runs inside [`super::kernels::wide`], so each is
 //! `#[inline(always)]` (the inlining rule of `kernels.rs`).
 
+#[cfg(target_arch = "x86_64")]
+use super::kernels::{self, x86};
 use super::kernels::{Neighbourhood, flushed};
 use super::level::{Level, Stencil};
 
@@ -67,6 +69,119 @@ fn coefficients(
     }
 }
 
+/// The [`LANES`] values of the slice `$s` from index `$at` as one AVX2 vector, unchecked
+/// (the caller's contract: `$s` holds `$at + LANES` values at least).
+#[cfg(target_arch = "x86_64")]
+macro_rules! lanes {
+    ($s:expr, $at:expr) => {{
+        debug_assert!($at + LANES <= $s.len());
+        // SAFETY: `$s` holds `$at + 8` values at least (the caller's contract); loadu reads
+        // them at any alignment.
+        unsafe { std::arch::x86_64::_mm256_loadu_ps($s.as_ptr().add($at)) }
+    }};
+}
+
+/// `keep · mid + (1 − keep) · new`, flushed, stored to `out`: the end of a chunk's update.
+///
+/// # Safety
+/// The processor must have AVX2 ([`super::kernels::avx2_on`]).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn store_kept(
+    out: &mut [f32; LANES],
+    keep: std::arch::x86_64::__m256,
+    mid: std::arch::x86_64::__m256,
+    new: std::arch::x86_64::__m256,
+) {
+    use std::arch::x86_64::{
+        _mm256_add_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
+    };
+    // SAFETY: the processor has AVX2 (the caller's contract); `out` holds 8 f32, which storeu
+    // writes at any alignment.
+    unsafe {
+        let kept = _mm256_mul_ps(keep, mid);
+        let changed = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(1.0), keep), new);
+        let v = x86::flushed(_mm256_add_ps(kept, changed));
+        _mm256_storeu_ps(out.as_mut_ptr(), v);
+    }
+}
+
+/// [`uniform`] for the [`LANES`] cells `i .. i + LANES` in AVX2, as [`coefficients_avx2`] is
+/// [`coefficients`]: the same values to the bit. The compiler vectorized [`uniform`]'s chunks
+/// well (34 instructions, 4 of them bounds checks): this one drops the checks (27), and makes
+/// both stencils' chunks one form.
+///
+/// # Safety
+/// The processor must have AVX2 ([`super::kernels::avx2_on`]), `row` must hold `i + LANES + 2`
+/// values at least and the other inputs `i + LANES`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn uniform_avx2(
+    out: &mut [f32; LANES],
+    row: &[f32],
+    (down, up): (&[f32], &[f32]),
+    (b, d, keep): (&[f32], &[f32], &[f32]),
+    i: usize,
+) {
+    use std::arch::x86_64::{_mm256_add_ps, _mm256_mul_ps};
+    let (west, mid, east) = (lanes!(row, i), lanes!(row, i + 1), lanes!(row, i + 2));
+    let (up, down) = (lanes!(up, i), lanes!(down, i));
+    let (b, d, keep) = (lanes!(b, i), lanes!(d, i), lanes!(keep, i));
+    // SAFETY: the processor has AVX2 (the caller's contract).
+    unsafe {
+        // d · (b + west + east + up + down), summed left to right.
+        let sum = _mm256_add_ps(_mm256_add_ps(b, west), east);
+        let sum = _mm256_add_ps(_mm256_add_ps(sum, up), down);
+        store_kept(out, keep, mid, _mm256_mul_ps(d, sum));
+    }
+}
+
+/// [`coefficients`] for the [`LANES`] cells `i .. i + LANES` in AVX2: the same operations in
+/// the same order on 8 lanes, so the same values to the bit.
+///
+/// Why by hand: on a chunk of 8 cells the compiler unrolls [`coefficients`]' loop, merges the
+/// loads that the shifted views share (cell `l`'s east is cell `l + 1`'s middle) into single
+/// floats, and gathers them back into vectors with shuffles: 59 instructions a chunk, the
+/// largest single loop of a crowd (11 % of its samples) and of the 1024² room (13 %). Here a
+/// chunk is 37, and the loop's samples fell by a fifth in a crowd; the 1024² room's solve
+/// took 8 % less time, the rooms map's longest field 4 % (with [`uniform_avx2`]).
+///
+/// Not a `#[target_feature]` function, which the compiler would not inline into its callers:
+/// it is inlined into [`super::kernels::wide`]'s AVX2 function, and so are the intrinsics it
+/// calls.
+///
+/// # Safety
+/// The processor must have AVX2 ([`super::kernels::avx2_on`]), and the inputs must hold the
+/// chunk's cells: `row` `i + LANES + 2` values at least, `east` `i + LANES + 1`, the others
+/// `i + LANES` (they are read unchecked: a check per input and chunk was a third of its
+/// instructions).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn coefficients_avx2(
+    out: &mut [f32; LANES],
+    row: &[f32],
+    (down, up): (&[f32], &[f32]),
+    (b, d, keep): (&[f32], &[f32], &[f32]),
+    (east, north, north_down): (&[f32], &[f32], &[f32]),
+    i: usize,
+) {
+    use std::arch::x86_64::{_mm256_add_ps, _mm256_mul_ps};
+    let (west, mid, east_x) = (lanes!(row, i), lanes!(row, i + 1), lanes!(row, i + 2));
+    let (e_west, e_mid) = (lanes!(east, i), lanes!(east, i + 1));
+    let (up, down) = (lanes!(up, i), lanes!(down, i));
+    let (no_mid, no_down) = (lanes!(north, i), lanes!(north_down, i));
+    let (b, d, keep) = (lanes!(b, i), lanes!(d, i), lanes!(keep, i));
+    // SAFETY: the processor has AVX2 (the caller's contract).
+    unsafe {
+        // d · (b + e_mid·east + e_west·west + n_mid·up + n_down·down), summed left to right.
+        let sum = _mm256_add_ps(b, _mm256_mul_ps(e_mid, east_x));
+        let sum = _mm256_add_ps(sum, _mm256_mul_ps(e_west, west));
+        let sum = _mm256_add_ps(sum, _mm256_mul_ps(no_mid, up));
+        let sum = _mm256_add_ps(sum, _mm256_mul_ps(no_down, down));
+        store_kept(out, keep, mid, _mm256_mul_ps(d, sum));
+    }
+}
+
 /// Writes the new values of the `n` cells of a row: `row` holds them with a cell either side
 /// (`n + 2` values), and `new(out, row, i)` computes those of cells `i .. i + out.len()` from
 /// the old values around them.
@@ -77,16 +192,22 @@ fn coefficients(
 /// per row and pass that was 7 % of a crowd's time on the windows' rows of 61 cells. The last
 /// chunk overlaps the one before it when `LANES` does not divide `n`; a cell both compute gets
 /// the same value from both. Every chunk starts at most `n − LANES` cells in, and its inputs
-/// are cut to the row once ([`Level::relax_row`]), so the compiler drops most of a chunk's
-/// bounds checks: 3 or 4 are left of 16, which were most of its instructions when each chunk
-/// sliced the level's whole vectors (without them a crowd's run takes 16 % less time, the
-/// rooms map's longest field 12 % and the 1024² room's solve 20 %, every value the same;
-/// cutting the inputs as `[k..][..n]` removes no more). A long row, or one shorter than
-/// `LANES`, is computed into the buffer `t` and copied back (on a long row the copy's call
-/// costs nothing, and the loop over the whole row is faster than chunks: measured, 1024² room,
-/// 8 % slower in chunks).
+/// are cut to the row once ([`Level::relax_row`]): `chunk(out, row, i)` computes the [`LANES`]
+/// cells from `i` as `new` does (the same values), with AVX2 reading them unchecked
+/// ([`uniform_avx2`], [`coefficients_avx2`]); else the compiler drops most of a chunk's bounds
+/// checks, 3 or 4 left of 16, which were most of its instructions when each chunk sliced the
+/// level's whole vectors (without them a crowd's run takes 16 % less time, the rooms map's
+/// longest field 12 % and the 1024² room's solve 20 %, every value the same). A long row, or
+/// one shorter than `LANES`, is computed into the buffer `t` and copied back (on a long row the
+/// copy's call costs nothing, and the loop over the whole row is faster than chunks: measured,
+/// 1024² room, 8 % slower in chunks before the AVX2 chunks, as fast with them).
 #[inline(always)]
-fn in_place(row: &mut [f32], t: &mut [f32], new: impl Fn(&mut [f32], &[f32], usize)) {
+fn in_place(
+    row: &mut [f32],
+    t: &mut [f32],
+    new: impl Fn(&mut [f32], &[f32], usize),
+    chunk: impl Fn(&mut [f32; LANES], &[f32], usize),
+) {
     let n = row.len() - 2;
     if !(LANES..LONG_ROW).contains(&n) {
         new(&mut t[..n], row, 0);
@@ -95,12 +216,12 @@ fn in_place(row: &mut [f32], t: &mut [f32], new: impl Fn(&mut [f32], &[f32], usi
     }
     let last = n - LANES;
     let mut pending = [0.0; LANES];
-    new(&mut pending, row, 0);
+    chunk(&mut pending, row, 0);
     let mut at = 0;
     while at < last {
         let i = (at + LANES).min(last);
         let mut next = [0.0; LANES];
-        new(&mut next, row, i);
+        chunk(&mut next, row, i);
         row[at + 1..at + 1 + LANES].copy_from_slice(&pending);
         (pending, at) = (next, i);
     }
@@ -229,30 +350,61 @@ impl Level {
         let up = &above[at.up - next..at.up - next + n];
         let (b, d) = (&b[at.mid..at.mid + n], &self.inv_diag[at.mid..at.mid + n]);
         match &self.stencil {
-            Stencil::Uniform => in_place(
-                row,
-                t,
-                #[inline(always)]
-                |out, row, i| uniform(out, row, (down, up), (b, d, keep), i),
-            ),
-            Stencil::Coefficients { east, north, .. } => {
-                let east = &east[at.mid - 1..at.mid + n];
-                let north_down = &north[at.down..at.down + n];
-                let north = &north[at.mid..at.mid + n];
+            Stencil::Uniform => {
+                #[cfg(target_arch = "x86_64")]
+                if kernels::avx2_on() {
+                    return in_place(
+                        row,
+                        t,
+                        #[inline(always)]
+                        |out, row, i| uniform(out, row, (down, up), (b, d, keep), i),
+                        #[inline(always)]
+                        |out, row, i| {
+                            // SAFETY: the processor has AVX2, checked just above; `in_place`
+                            // starts a chunk at most `n − LANES` cells in, `row` holds `n + 2`
+                            // values and the others `n` (cut above).
+                            unsafe { uniform_avx2(out, row, (down, up), (b, d, keep), i) }
+                        },
+                    );
+                }
                 in_place(
                     row,
                     t,
                     #[inline(always)]
-                    |out, row, i| {
-                        coefficients(
-                            out,
-                            row,
-                            (down, up),
-                            (b, d, keep),
-                            (east, north, north_down),
-                            i,
-                        )
-                    },
+                    |out, row, i| uniform(out, row, (down, up), (b, d, keep), i),
+                    #[inline(always)]
+                    |out, row, i| uniform(out, row, (down, up), (b, d, keep), i),
+                )
+            }
+            Stencil::Coefficients { east, north, .. } => {
+                let east = &east[at.mid - 1..at.mid + n];
+                let north_down = &north[at.down..at.down + n];
+                let north = &north[at.mid..at.mid + n];
+                let (rows, inputs, couplings) =
+                    ((down, up), (b, d, keep), (east, north, north_down));
+                #[cfg(target_arch = "x86_64")]
+                if kernels::avx2_on() {
+                    return in_place(
+                        row,
+                        t,
+                        #[inline(always)]
+                        |out, row, i| coefficients(out, row, rows, inputs, couplings, i),
+                        #[inline(always)]
+                        |out, row, i| {
+                            // SAFETY: the processor has AVX2, checked just above; `in_place`
+                            // starts a chunk at most `n − LANES` cells in, `row` holds `n + 2`
+                            // values, `east` `n + 1` and the others `n` (cut above).
+                            unsafe { coefficients_avx2(out, row, rows, inputs, couplings, i) }
+                        },
+                    );
+                }
+                in_place(
+                    row,
+                    t,
+                    #[inline(always)]
+                    |out, row, i| coefficients(out, row, rows, inputs, couplings, i),
+                    #[inline(always)]
+                    |out, row, i| coefficients(out, row, rows, inputs, couplings, i),
                 )
             }
         }
@@ -369,6 +521,75 @@ impl Level {
                     row[i] = b[i] - ax;
                 }
             }
+        }
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::*;
+
+    /// Values of every kind a chunk meets: ordinary ones of both signs, values about the flush
+    /// level (which the update rounds to 0 or keeps), zeros of both signs, and keep patterns
+    /// of 0 and 1.
+    fn values(n: usize, seed: u64) -> Vec<f32> {
+        let mut state = seed;
+        (0..n)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let u = (state >> 40) as f32 / (1u64 << 24) as f32;
+                match state % 11 {
+                    0 => 0.0,
+                    1 => -0.0,
+                    2 => (u - 0.5) * 3e-30,
+                    // Not a multiple of one power of two (u is), so that sums round.
+                    _ => (u - 0.5) * 8.0 / (1.1 + u),
+                }
+            })
+            .collect()
+    }
+
+    /// The AVX2 chunks give the portable loops' values to the bit, at every offset of a row.
+    #[test]
+    fn the_avx2_chunks_give_the_loops_values_to_the_bit() {
+        if !kernels::avx2_on() {
+            return;
+        }
+        let n = 203;
+        let row = values(n + 2, 1);
+        let (down, up, b, d) = (values(n, 2), values(n, 3), values(n, 4), values(n, 5));
+        let keep: Vec<f32> = (0..n).map(|i| (i % 2) as f32).collect();
+        let (east, north, north_down) = (values(n + 1, 6), values(n, 7), values(n, 8));
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for i in 0..=n - LANES {
+            let (mut by_loop, mut by_avx2) = ([0.0; LANES], [0.0; LANES]);
+            uniform(&mut by_loop, &row, (&down, &up), (&b, &d, &keep), i);
+            // SAFETY: AVX2 checked above; every input holds `i + LANES` values and more.
+            unsafe { uniform_avx2(&mut by_avx2, &row, (&down, &up), (&b, &d, &keep), i) };
+            assert_eq!(bits(&by_loop), bits(&by_avx2), "uniform at {i}");
+            let couplings = (&east[..], &north[..], &north_down[..]);
+            coefficients(
+                &mut by_loop,
+                &row,
+                (&down, &up),
+                (&b, &d, &keep),
+                couplings,
+                i,
+            );
+            // SAFETY: as above.
+            unsafe {
+                coefficients_avx2(
+                    &mut by_avx2,
+                    &row,
+                    (&down, &up),
+                    (&b, &d, &keep),
+                    couplings,
+                    i,
+                )
+            };
+            assert_eq!(bits(&by_loop), bits(&by_avx2), "coefficients at {i}");
         }
     }
 }
