@@ -209,8 +209,17 @@ impl Crop {
     /// The box of `grid` around its `unknown` cells, if it is at most half the grid (and not
     /// empty).
     fn of(grid: &Grid, unknown: &[bool]) -> Option<Self> {
-        let cells = (unknown.iter().enumerate()).filter_map(|(k, u)| u.then_some(k));
-        let (i, j) = grid.box_around(cells)?;
+        if grid.nx == 0 {
+            return None;
+        }
+        // Each row's first and last unknown cell, by row: the cells' own indices would be
+        // divided by the row length, two divisions a cell (2 % of a crowd's time).
+        let ends = (unknown.chunks_exact(grid.nx).enumerate()).flat_map(|(j, row)| {
+            let first = row.iter().position(|&u| u);
+            let last = row.iter().rposition(|&u| u);
+            first.into_iter().chain(last).map(move |i| (i, j))
+        });
+        let (i, j) = grid.box_of(ends)?;
         (2 * i.len() * j.len() <= grid.len()).then_some(Self { i, j })
     }
 
@@ -223,18 +232,25 @@ impl Crop {
         max_iterations: usize,
     ) -> Stats {
         let sub = grid.part(self.i.clone(), self.j.clone());
-        let global = |k: usize| grid.index(self.i.start + k % sub.nx, self.j.start + k / sub.nx);
-        let sub_unknown: Vec<bool> = (0..sub.len()).map(|k| unknown[global(k)]).collect();
-        let mut sub_values: Vec<f64> = (0..sub.len()).map(|k| values[global(k)]).collect();
+        // The box's part of row `j` of the grid.
+        let row = |j: usize| grid.index(self.i.start, j)..grid.index(self.i.end, j);
+        let rows = || self.j.clone().map(row);
+        let sub_unknown: Vec<bool> = rows().flat_map(|r| &unknown[r]).copied().collect();
+        let mut sub_values: Vec<f64> = rows().flat_map(|r| &values[r]).copied().collect();
         let sub_problem = (
             &Rows::whole(sub.nx, sub.ny),
             &sub_unknown[..],
             &mut sub_values[..],
         );
         let stats = solve_all(cycle, sub_problem, tolerance, max_iterations);
-        for (k, v) in sub_values.into_iter().enumerate() {
-            if sub_unknown[k] {
-                values[global(k)] = v;
+        let solved = sub_unknown
+            .chunks_exact(sub.nx)
+            .zip(sub_values.chunks_exact(sub.nx));
+        for (r, (unknown, solved)) in rows().zip(solved) {
+            for ((v, &u), &s) in values[r].iter_mut().zip(unknown).zip(solved) {
+                if u {
+                    *v = s;
+                }
             }
         }
         stats
