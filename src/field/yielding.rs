@@ -303,6 +303,7 @@ fn cells_near(grid: &Grid, center: [f64; 2], radius: f64) -> Vec<usize> {
 mod tests {
     use super::super::streamline::polyline_distance;
     use super::*;
+    use crate::random::SplitMix;
 
     fn straight(from: [f64; 2], to: [f64; 2], n: usize) -> Streamline {
         Streamline {
@@ -334,13 +335,8 @@ mod tests {
     /// first does not reach, among them), and a way of one point and of none.
     #[test]
     fn the_box_answers_as_the_segments() {
-        let mut state = 7u64;
-        let mut random = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix::new(7);
+        let mut random = move || rng.uniform();
         let mut checked = [0; 2];
         for case in 0..400 {
             let n = case % 7;

@@ -528,23 +528,21 @@ impl Level {
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests {
     use super::*;
+    use crate::random::SplitMix;
 
     /// Values of every kind a chunk meets: ordinary ones of both signs, values about the flush
     /// level (which the update rounds to 0 or keeps), zeros of both signs, and keep patterns
     /// of 0 and 1.
     fn values(n: usize, seed: u64) -> Vec<f32> {
-        let mut state = seed;
+        let mut rng = SplitMix::new(seed);
         (0..n)
             .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let u = (state >> 40) as f32 / (1u64 << 24) as f32;
-                match state % 11 {
+                let u = rng.uniform() as f32;
+                match rng.next_u64() % 11 {
                     0 => 0.0,
                     1 => -0.0,
                     2 => (u - 0.5) * 3e-30,
-                    // Not a multiple of one power of two (u is), so that sums round.
+                    // Not a multiple of one power of two, so that sums round.
                     _ => (u - 0.5) * 8.0 / (1.1 + u),
                 }
             })
