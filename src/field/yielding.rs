@@ -214,12 +214,10 @@ impl FreeSpace {
         let mut near = vec![false; grid.len()];
         for way in ways {
             let reach = way.radius + agent.radius + CLEAR_OF_WAY;
-            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-            for p in way.points.iter() {
-                lo = [lo[0].min(p[0] - reach), lo[1].min(p[1] - reach)];
-                hi = [hi[0].max(p[0] + reach), hi[1].max(p[1] + reach)];
-            }
-            let (ir, jr) = grid.cells_in(lo, hi);
+            // The box of all its points, grown (the same bounds as growing each point first:
+            // a sum rounds monotonically).
+            let Bounds { lo, hi } = way.bounds[0];
+            let (ir, jr) = grid.cells_in(lo.map(|v| v - reach), hi.map(|v| v + reach));
             for j in jr {
                 for i in ir.clone() {
                     let k = grid.index(i, j);
