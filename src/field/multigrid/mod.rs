@@ -10,11 +10,13 @@
 //! operators `R A P`. These stay 5-point stencils and follow the mask exactly, however thin its
 //! walls are: two regions that a wall separates are never coupled on a coarse level. Each level
 //! smooths with red-black Gauss-Seidel (red then black before the coarse correction, black then red
-//! after it) and the coarsest level is solved exactly (Cholesky), so the cycle is a symmetric
+//! after it; twice on the W-cycle's finest level, once elsewhere: see `Cycle::sweeps` in
+//! `cycle.rs`) and the coarsest level is solved exactly (Cholesky), so the cycle is a symmetric
 //! operator, as CG needs. A V-cycle of this hierarchy loses a little on every level (26 CG
 //! iterations at 1024², growing with the grid); visiting each coarse level twice (the W-cycle)
-//! keeps the count flat (11 at 256² and at 2048²) for about 1.5× the work per cycle. A caller may
-//! ask for the V-cycle ([`solve_with`]): the windows of local replanning do (see `window.rs`).
+//! keeps the count flat (11 at 256² and at 2048², measured with two sweeps on every level) for
+//! about 1.5× the work per cycle. A caller may ask for the V-cycle ([`solve_with`]): the windows
+//! of local replanning do (see `window.rs`).
 //!
 //! The cycle runs in f32. It only has to approximate `A⁻¹`: its rounding (1e-7) is far below
 //! its approximation error, CG in f64 corrects both, and f32 halves the memory traffic, which is
