@@ -21,6 +21,7 @@
 //!   box, with the distance from the cell's centre to one convex polygon.
 
 use super::Grid;
+use super::bounds::Bounds;
 use crate::world::WallShape;
 
 /// Why a body's shape cannot be masked.
@@ -158,13 +159,7 @@ impl HeadingMask {
                 })
                 .collect();
             // The box: the body's extent along each axis at this heading, grown by the margin.
-            let (mut min, mut max) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-            for p in turned.iter().flatten() {
-                for a in 0..2 {
-                    min[a] = min[a].min(p[a]);
-                    max[a] = max[a].max(p[a]);
-                }
-            }
+            let Bounds { lo: min, hi: max } = Bounds::of(turned.iter().flatten());
             for j in 0..grid.ny {
                 for i in 0..grid.nx {
                     let [x, y] = grid.center(i, j);
@@ -181,13 +176,7 @@ impl HeadingMask {
                 let grow = radius + margin;
                 for part in &turned {
                     let obstacle = minkowski_difference(core, part);
-                    let (mut lo_b, mut hi_b) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-                    for p in &obstacle {
-                        for a in 0..2 {
-                            lo_b[a] = lo_b[a].min(p[a] - grow);
-                            hi_b[a] = hi_b[a].max(p[a] + grow);
-                        }
-                    }
+                    let Bounds { lo: lo_b, hi: hi_b } = Bounds::of(&obstacle).grown(grow);
                     let (ir, jr) = grid.cells_in(lo_b, hi_b);
                     for j in jr {
                         for i in ir.clone() {

@@ -22,6 +22,7 @@
 //! ```
 
 mod banded;
+mod bounds;
 pub mod export;
 mod firas;
 mod grid;

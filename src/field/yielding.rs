@@ -41,6 +41,7 @@
 
 use std::sync::Arc;
 
+use super::bounds::Bounds;
 use super::grid::Grid;
 use super::laplace;
 use super::mask::{Disc, FreeSpace};
@@ -80,38 +81,6 @@ pub struct Way {
 /// segments, m: far above the rounding of a segment's distance (1e-13 m on a map of a few
 /// hundred metres), so a skipped way is one whose test the segments would have failed too.
 const BOX_SLACK: f64 = 1e-9;
-
-/// The axis-aligned box of some points, m (empty for none).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Bounds {
-    lo: [f64; 2],
-    hi: [f64; 2],
-}
-
-impl Bounds {
-    /// The box of `points`.
-    fn of(points: &[[f64; 2]]) -> Self {
-        let mut b = Self {
-            lo: [f64::INFINITY; 2],
-            hi: [f64::NEG_INFINITY; 2],
-        };
-        for p in points {
-            b.lo = [b.lo[0].min(p[0]), b.lo[1].min(p[1])];
-            b.hi = [b.hi[0].max(p[0]), b.hi[1].max(p[1])];
-        }
-        b
-    }
-
-    /// The distance from `p` to the box, m: 0 inside it, infinite for an empty box.
-    fn distance(&self, p: [f64; 2]) -> f64 {
-        if self.lo[0] > self.hi[0] {
-            return f64::INFINITY;
-        }
-        let dx = (self.lo[0] - p[0]).max(p[0] - self.hi[0]).max(0.0);
-        let dy = (self.lo[1] - p[1]).max(p[1] - self.hi[1]).max(0.0);
-        dx.hypot(dy)
-    }
-}
 
 impl Way {
     /// The first [`WAY_AHEAD`] metres of `streamline` for a disc of `radius` m.
@@ -214,10 +183,8 @@ impl FreeSpace {
         let mut near = vec![false; grid.len()];
         for way in ways {
             let reach = way.radius + agent.radius + CLEAR_OF_WAY;
-            // The box of all its points, grown (the same bounds as growing each point first:
-            // a sum rounds monotonically).
-            let Bounds { lo, hi } = way.bounds[0];
-            let (ir, jr) = grid.cells_in(lo.map(|v| v - reach), hi.map(|v| v + reach));
+            let Bounds { lo, hi } = way.bounds[0].grown(reach);
+            let (ir, jr) = grid.cells_in(lo, hi);
             for j in jr {
                 for i in ir.clone() {
                     let k = grid.index(i, j);
