@@ -37,20 +37,9 @@ impl Krylov {
         let (nx, ny) = (problem.nx, problem.ny);
         let n = fine.len();
         // `fixed` holds the Dirichlet values and then becomes the residual: fresh memory costs
-        // page faults. The level stores every cell next to an active one (see `level.rs`).
+        // page faults.
         let mut x = vec![0.0; n];
-        let mut fixed = vec![0.0; n];
-        for j in 0..ny {
-            let (k, cols, row) = both(fine, problem, j);
-            for (((x, f), v), u) in x[k..k + cols.len()]
-                .iter_mut()
-                .zip(&mut fixed[k..k + cols.len()])
-                .zip(&values[row.clone()])
-                .zip(&unknown[row])
-            {
-                (*x, *f) = if *u { (*v, 0.0) } else { (0.0, *v) };
-            }
-        }
+        let mut fixed = laid_out(fine, problem, (unknown, values), Some(&mut x));
         // r = b − A x row by row, trailing two rows behind so that `fixed` (read up to a row
         // ahead) can be overwritten with r. Only a row's span holds active cells (a nested
         // part's box is mostly empty); the sums skip only zeros, so they are those over the
@@ -110,9 +99,9 @@ impl Krylov {
 
     /// The relative residual `‖b − A x‖ / ‖b‖` recomputed from the solution (not CG's
     /// recurrence), with the Dirichlet values read from `values` as [`Krylov::start`] reads
-    /// them: to the bit what a new start from the solution would measure, over the rows'
-    /// spans only and without a new start's vectors over the whole box (a nested part's box
-    /// is mostly empty).
+    /// them (see `laid_out`): to the bit what a new start from the solution would measure, over
+    /// the rows' spans only (a nested part's box is mostly empty) and with one vector on the
+    /// level's layout where a new start makes three.
     pub fn true_relative(
         &self,
         fine: &Level,
@@ -121,51 +110,24 @@ impl Krylov {
         values: &[f64],
     ) -> f64 {
         let (nx, ny) = (problem.nx, problem.ny);
-        // The Dirichlet values of rows j − 1, j and j + 1 of the problem, as `start` holds
-        // them (0 on unknown cells, on cells not stored and off the grid), by padded column
-        // (column i at i + 1): each cell's four neighbours' values are then read from three
-        // rows at fixed offsets, a loop the compiler vectorizes (it looked each one up in the
-        // problem's rows: 1.9 % of 64 robots' time on the 1.8 m circle, 0.4 % now, the same
-        // sums to the bit). Each buffer remembers the columns it holds, which are cleared
-        // before it takes another row.
-        let mut dirichlet = [0, 1, 2].map(|_| (vec![0.0; nx + 2], 0..0));
-        let load = |(buffer, held): &mut (Vec<f64>, Range<usize>), j: usize| {
-            buffer[held.clone()].fill(0.0);
-            *held = 0..0;
-            if j < ny {
-                let (k, cols) = problem.row(j);
-                let to = cols.start + 1..cols.end + 1;
-                for ((d, v), u) in buffer[to.clone()]
-                    .iter_mut()
-                    .zip(&values[k..k + cols.len()])
-                    .zip(&unknown[k..k + cols.len()])
-                {
-                    *d = if *u { 0.0 } else { *v };
-                }
-                *held = to;
-            }
-        };
-        // Rows j − 1, j, j + 1 are in buffers (j + 2) % 3, j % 3, (j + 1) % 3.
-        load(&mut dirichlet[0], 0);
+        let fixed = laid_out(fine, problem, (unknown, values), None);
         let mut row = vec![0.0; nx];
         let mut rr = 0.0;
         for j in 0..ny {
-            load(&mut dirichlet[(j + 1) % 3], j + 1);
             let (at, cols) = fine.run(j);
             let n = cols.len();
+            let f = Neighbourhood::of(&fixed, at, n);
             let u = Neighbourhood::of(&self.x, at, n);
             let d = &fine.inv_diag[at.mid..at.mid + n];
-            // (At j = 0, row j − 1's buffer has held no row: all 0.)
-            let [below, here, above] = [(j + 2) % 3, j % 3, (j + 1) % 3].map(|b| &dirichlet[b].0);
-            let c = cols.start;
-            let (west, east) = (&here[c..c + n], &here[c + 2..c + 2 + n]);
-            let (north, south) = (&above[c + 1..c + 1 + n], &below[c + 1..c + 1 + n]);
             let out = &mut row[cols.clone()];
+            // A loop the compiler vectorizes: each neighbour's value at a fixed offset (it
+            // looked each one up in the problem's rows: 1.9 % of 64 robots' time on the 1.8 m
+            // circle, about 0.6 % now with its half of `laid_out`; the same sums to the bit).
             wide(
                 #[inline(always)]
                 || {
                     for l in 0..n {
-                        let f = [west[l], east[l], north[l], south[l]];
+                        let f = [f.west[l], f.east[l], f.up[l], f.down[l]];
                         let u = [u.mid[l], u.west[l], u.east[l], u.up[l], u.down[l]];
                         // Inactive cells hold 0 (as the row does between rows).
                         out[l] = if d[l] != 0.0 {
@@ -393,6 +355,34 @@ fn both(fine: &Level, rows: &Rows, j: usize) -> (usize, Range<usize>, Range<usiz
         common.clone(),
         u..u + common.len(),
     )
+}
+
+/// The Dirichlet values of `problem` on the fine level's layout: `values` on its known cells,
+/// 0 on its unknown ones and on the cells the level stores beyond it (the level stores every
+/// cell next to an active one, see `level.rs`); with `guess`, the starting guess into it:
+/// `values` on the unknown cells, 0 elsewhere. What [`Krylov::start`] starts from and
+/// [`Krylov::true_relative`] measures with.
+fn laid_out(
+    fine: &Level,
+    problem: &Rows,
+    (unknown, values): (&[bool], &[f64]),
+    mut guess: Option<&mut [f64]>,
+) -> Vec<f64> {
+    let mut fixed = vec![0.0; fine.len()];
+    for j in 0..problem.ny {
+        let (k, cols, row) = both(fine, problem, j);
+        let (values, unknown) = (&values[row.clone()], &unknown[row]);
+        let cells = k..k + cols.len();
+        for ((f, v), u) in fixed[cells.clone()].iter_mut().zip(values).zip(unknown) {
+            *f = if *u { 0.0 } else { *v };
+        }
+        if let Some(x) = guess.as_deref_mut() {
+            for ((x, v), u) in x[cells].iter_mut().zip(values).zip(unknown) {
+                *x = if *u { *v } else { 0.0 };
+            }
+        }
+    }
+    fixed
 }
 
 /// `q · A q` on row `j` (`q` starting at index `origin`), with `row` to hold `A q`.
