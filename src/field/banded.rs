@@ -403,22 +403,7 @@ mod tests {
     /// A corridor of `len` cells, `width` wide, as local neighbour lists, cell `(i, j)` at
     /// `j * len + i`.
     fn corridor(len: usize, width: usize) -> Vec<Neighbours> {
-        let id = |i: usize, j: usize| (j * len + i) as u32;
-        (0..width)
-            .flat_map(|j| (0..len).map(move |i| (i, j)))
-            .map(|(i, j)| {
-                [
-                    if i > 0 { id(i - 1, j) } else { u32::MAX },
-                    if i + 1 < len { id(i + 1, j) } else { u32::MAX },
-                    if j > 0 { id(i, j - 1) } else { u32::MAX },
-                    if j + 1 < width {
-                        id(i, j + 1)
-                    } else {
-                        u32::MAX
-                    },
-                ]
-            })
-            .collect()
+        masked(len, width, |_, _| true)
     }
 
     /// A corridor one cell wide, fed 1 at its first cell: `u` falls by `2 − √3` per cell, and
@@ -467,32 +452,7 @@ mod tests {
     fn a_part_is_refused_exactly_when_its_band_is_too_wide() {
         let mut shapes: Vec<Vec<Neighbours>> = (1..12).map(|w| corridor(40, w)).collect();
         // A comb: a spine along j = 0 of 30 cells, a tooth of 6 cells up from every other one.
-        let cell = |i: usize, j: usize| (j == 0 || i.is_multiple_of(2)).then_some(j * 30 + i);
-        let cells: Vec<(usize, usize)> = (0..7)
-            .flat_map(|j| (0..30).map(move |i| (i, j)))
-            .filter(|&(i, j)| cell(i, j).is_some())
-            .collect();
-        let local = |i: usize, j: usize| {
-            cell(i, j).and_then(|c| cells.iter().position(|&(a, b)| b * 30 + a == c))
-        };
-        shapes.push(
-            cells
-                .iter()
-                .map(|&(i, j)| {
-                    let at = |a: Option<usize>, b: Option<usize>| match (a, b) {
-                        (Some(a), Some(b)) if a < 30 && b < 7 => local(a, b),
-                        _ => None,
-                    };
-                    [
-                        at(i.checked_sub(1), Some(j)),
-                        at(Some(i + 1), Some(j)),
-                        at(Some(i), j.checked_sub(1)),
-                        at(Some(i), Some(j + 1)),
-                    ]
-                    .map(|m| m.map_or(u32::MAX, |m| m as u32))
-                })
-                .collect(),
-        );
+        shapes.push(masked(30, 7, |i, j| j == 0 || i.is_multiple_of(2)));
         // A path of 41 cells numbered from its middle: the search from its first cell meets
         // the bound's limit at every step (2 d + 1 cells within d steps, band 1).
         let at = |i: usize| (i as u32 + 21) % 41;

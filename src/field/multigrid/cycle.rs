@@ -160,11 +160,9 @@ pub struct Hierarchy {
     keep: Keep,
     /// The coarsest solve's scratch.
     scratch: Vec<f64>,
-    /// Coarse-level visits per visit of the level above (see [`Cycle`]).
-    visits: usize,
-    /// Sweeps before and after a coarse correction on the finest level and below (see
-    /// [`Cycle::sweeps`]).
-    sweeps: [usize; 2],
+    /// The cycle: its coarse-level visits per visit of the level above and its sweeps on each
+    /// level ([`Cycle::visits`], [`Cycle::sweeps`]).
+    cycle: Cycle,
 }
 
 impl Hierarchy {
@@ -201,8 +199,7 @@ impl Hierarchy {
             coarsest,
             work,
             scratch: Vec::new(),
-            visits: cycle.visits(),
-            sweeps: cycle.sweeps(),
+            cycle,
         }
     }
 
@@ -221,7 +218,7 @@ impl Hierarchy {
             return if l == 0 { dot(x, b) } else { 0.0 };
         }
         self.smooth_and_restrict(l, zero_start);
-        for visit in 0..self.visits {
+        for visit in 0..self.cycle.visits() {
             self.cycle(l + 1, visit == 0);
         }
         self.prolong_and_smooth(l)
@@ -229,7 +226,7 @@ impl Hierarchy {
 
     /// Sweeps before and after a coarse correction on level `l` (see [`Cycle::sweeps`]).
     fn sweeps_on(&self, l: usize) -> usize {
-        self.sweeps[usize::from(l > 0)]
+        self.cycle.sweeps()[usize::from(l > 0)]
     }
 
     /// Pre-smoothing on level `l` (red then black, [`Cycle::sweeps`] times), then its residual
